@@ -1,0 +1,12 @@
+#!/bin/sh
+# The main job: installs what is missing, builds, and simulates a scene
+# (by default the demo drape) into out/<scene name>/.
+set -eu
+cd "$(dirname "$0")/.."
+scripts/install-deps.sh
+cmake -S . -B build -DCMAKE_BUILD_TYPE=Release >/dev/null
+cmake --build build -j"$(nproc)"
+SCENE="${1:-scenes/drape.yaml}"
+[ $# -gt 0 ] && shift
+NAME="$(basename "$SCENE" .yaml)"
+exec build/clothsim run "$SCENE" -o "out/$NAME" "$@"

@@ -1,0 +1,122 @@
+/* body.c: collision bodies as signed distances in a moving rigid frame.
+ * Analytic shapes live here; grid bodies (level sets from meshes) enter
+ * through cs_body_def.phi_fn with the same interface. */
+#include <string.h>
+
+#include "sim/sim.h"
+#include "sim/vec3.h"
+
+cs_body_def cs_default_body_def(void)
+{
+    cs_body_def b;
+    memset(&b, 0, sizeof b);
+    b.shape = CS_BODY_PLANE;
+    b.radius = 1.0;
+    b.half_extents[0] = b.half_extents[1] = b.half_extents[2] = 0.5;
+    b.half_height = 0.5;
+    b.friction = 0.3;
+    b.motion = cs_motion_static();
+    return b;
+}
+
+static double sign_of(double a) { return a < 0 ? -1.0 : 1.0; }
+
+static double phi_plane(const double p[3], double g[3])
+{
+    g[0] = 0;
+    g[1] = 1;
+    g[2] = 0;
+    return p[1];
+}
+
+static double phi_sphere(double r, const double p[3], double g[3])
+{
+    double n = cs_norm(p);
+    if (n > 0) {
+        for (int i = 0; i < 3; i++)
+            g[i] = p[i] / n;
+    } else { /* the centre: any direction is a steepest one */
+        g[0] = 0;
+        g[1] = 1;
+        g[2] = 0;
+    }
+    return n - r;
+}
+
+static double phi_box(const double h[3], const double p[3], double g[3])
+{
+    double q[3], outside[3];
+    int axis = 0;
+    for (int i = 0; i < 3; i++) {
+        q[i] = fabs(p[i]) - h[i];
+        outside[i] = q[i] > 0 ? q[i] : 0;
+        if (q[i] > q[axis])
+            axis = i;
+    }
+    double d = cs_norm(outside);
+    if (d > 0) {
+        for (int i = 0; i < 3; i++)
+            g[i] = outside[i] / d * sign_of(p[i]);
+        return d;
+    }
+    g[0] = g[1] = g[2] = 0;
+    g[axis] = sign_of(p[axis]);
+    return q[axis];
+}
+
+static double phi_cylinder(double r, double hh, const double p[3], double g[3])
+{
+    double rho = sqrt(p[0] * p[0] + p[2] * p[2]);
+    double radial[3] = {0, 0, 1}; /* any horizontal direction on the axis */
+    if (rho > 0) {
+        radial[0] = p[0] / rho;
+        radial[2] = p[2] / rho;
+    }
+    double dr = rho - r, dy = fabs(p[1]) - hh;
+    if (dr > 0 && dy > 0) { /* nearest to the rim */
+        double d = sqrt(dr * dr + dy * dy);
+        for (int i = 0; i < 3; i++)
+            g[i] = (radial[i] * dr) / d;
+        g[1] = sign_of(p[1]) * dy / d;
+        return d;
+    }
+    if (dr > dy) {
+        memcpy(g, radial, 3 * sizeof *g);
+        return dr;
+    }
+    g[0] = g[2] = 0;
+    g[1] = sign_of(p[1]);
+    return dy;
+}
+
+double cs_body_def_phi(const cs_body_def *b, double t, const double x[3], double grad[3])
+{
+    double R[9], c[3], rel[3], p[3], g[3];
+    cs_motion_pose(&b->motion, t, R, c, NULL, NULL);
+    cs_sub(x, c, rel);
+    cs_mat_apply_transpose(R, rel, p);
+    double phi;
+    if (b->phi_fn) {
+        phi = b->phi_fn(b->phi_data, p, g);
+    } else {
+        switch (b->shape) {
+        case CS_BODY_SPHERE: phi = phi_sphere(b->radius, p, g); break;
+        case CS_BODY_BOX: phi = phi_box(b->half_extents, p, g); break;
+        case CS_BODY_CYLINDER: phi = phi_cylinder(b->radius, b->half_height, p, g); break;
+        case CS_BODY_PLANE:
+        default: phi = phi_plane(p, g); break;
+        }
+    }
+    cs_mat_apply(R, g, grad);
+    return phi;
+}
+
+void cs_body_def_velocity(const cs_body_def *b, double t, const double x[3], double v[3])
+{
+    double c[3], vel[3], w[3], r[3], wr[3];
+    cs_motion_pose(&b->motion, t, NULL, c, vel, w);
+    cs_sub(x, c, r);
+    cs_cross(w, r, wr);
+    for (int i = 0; i < 3; i++)
+        v[i] = vel[i] + wr[i];
+}

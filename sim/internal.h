@@ -1,0 +1,78 @@
+/* internal.h: the simulation state, private to sim/. Particle arrays are
+ * flat (3 doubles per particle) and free of bookkeeping. */
+#ifndef CS_INTERNAL_H
+#define CS_INTERNAL_H
+
+#include "sim/sim.h"
+#include "sim/springs.h"
+
+/* What the solver may change about a particle's velocity. */
+enum { CS_FIXED = 0, CS_FREE = 1, CS_CONTACT = 2 };
+
+typedef struct cs_script_state {
+    cs_motion motion;     /* keys owned by the sim */
+    double rotation0[9];  /* R(0), to express vertices in the frame */
+    int nvertices;
+    int *vertices;        /* global particle indices */
+    double *local;        /* 3 per vertex: R(0)^T (x0 - c(0)) */
+} cs_script_state;
+
+typedef struct cs_cloth_state {
+    char *name;
+    int offset;
+    cs_trimesh *mesh;
+} cs_cloth_state;
+
+typedef struct cs_cg_work {
+    double *z, *r, *y, *p, *q, *diag, *b;
+} cs_cg_work;
+
+struct cs_sim {
+    cs_sim_def def;               /* arrays below replace the def's pointers */
+    cs_plan plan;
+    int n;                        /* particles */
+    double *x, *v, *mass;
+    unsigned char *is_free;       /* 0 for pinned and scripted particles */
+    unsigned char *mode;          /* CS_FIXED / CS_FREE / CS_CONTACT this step */
+
+    int ncloths;
+    cs_cloth_state *cloths;
+    int nscripts;
+    cs_script_state *scripts;
+    double *script_x, *script_v;  /* 3 per particle: targets at t^{n+1} */
+    int nbodies;
+    cs_body_def *bodies;          /* motion keys owned by the sim */
+    cs_springs springs;
+
+    /* step scratch */
+    double *x_prev, *v_half, *v_star, *v_next, *force, *v0, *rhs;
+    cs_cg_work cg;
+    /* body stages only */
+    double *contact_normal;       /* 3 per particle */
+    int *contact_body;            /* -1 when not in contact */
+    /* wind stage only */
+    double *wind_normal;          /* 3 per particle, area weighted unit normal */
+    double *wind_area;            /* 1 per particle */
+
+    double t, dt, stable_dt, h;   /* h: half step of the current solve */
+    cs_stage_timing timing[CS_STAGE_COUNT];
+    size_t stage_bytes[CS_STAGE_COUNT];
+    long cg_iterations, contacts;
+};
+
+/* cg.c: solves P (M - h D) P z = P (rhs - (M - h D) v0) for v = v0 + z,
+ * where P projects out fixed velocities and contact normals. Returns the
+ * iteration count. */
+int cs_cg_solve(cs_sim *sim, const double *v0, const double *rhs, double *v);
+/* out = (M - h D) v, D the damping (and wind drag) velocity Jacobian. */
+void cs_system_apply(const cs_sim *sim, const double *v, double *out);
+/* out += D v (damping plus implicit wind drag). */
+void cs_damping_apply(const cs_sim *sim, const double *v, double *out);
+
+/* contact.c: Section 6. */
+void cs_gamma(const double v[3], const double N[3], const double vb[3], double mu,
+              double out[3]);
+void cs_body_collide(cs_sim *sim, double dt);
+void cs_body_friction(cs_sim *sim, double dt);
+
+#endif

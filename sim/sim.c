@@ -1,0 +1,567 @@
+/* sim.c: creating the simulation and the semi-implicit Newmark step of
+ * Section 3 (B.1, B.3-B.7), timed stage by stage. Self-collision steps
+ * (A, B.2, B.8, C) plug in around these in the outer collision loop. */
+#include <math.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+#include "sim/internal.h"
+#include "sim/vec3.h"
+
+cs_cloth_material cs_default_cloth_material(void)
+{
+    cs_cloth_material m = {
+        .edge_stiffness = 4.14,
+        .edge_overdamping = 15,
+        .bend_stiffness = 0.41,
+        .bend_overdamping = 8,
+        .node_mass = 1e-6,
+        .density = 0,
+    };
+    return m;
+}
+
+cs_sim_def cs_default_sim_def(void)
+{
+    cs_sim_def d;
+    memset(&d, 0, sizeof d);
+    d.gravity[1] = -9.8;
+    d.fps = 24;
+    d.dt = 0;
+    d.dt_safety = 0.5;
+    d.collision_steps = 16;
+    d.cg_tolerance = 1e-3;
+    d.cg_max_iterations = 1000;
+    d.friction_method = CS_FRICTION_IMPROVED;
+    d.bodies_enabled = true;
+    d.wind_enabled = false;
+    return d;
+}
+
+static double now(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+#define STAGE_BEGIN(sim, stage) double stage_t0_##stage = now()
+#define STAGE_END(sim, stage)                                          \
+    do {                                                               \
+        (sim)->timing[stage].seconds += now() - stage_t0_##stage;      \
+        (sim)->timing[stage].calls++;                                  \
+    } while (0)
+
+static int fail(char *err, size_t errlen, const char *fmt, ...)
+{
+    if (err && errlen) {
+        va_list ap;
+        va_start(ap, fmt);
+        vsnprintf(err, errlen, fmt, ap);
+        va_end(ap);
+    }
+    return CS_ERR_INVALID;
+}
+
+static bool finite3(const double a[3])
+{
+    return isfinite(a[0]) && isfinite(a[1]) && isfinite(a[2]);
+}
+
+static int validate(const cs_sim_def *def, char *err, size_t errlen)
+{
+    if (def->ncloths < 1)
+        return fail(err, errlen, "a scene needs at least one cloth");
+    if (!(def->fps > 0))
+        return fail(err, errlen, "fps must be > 0");
+    if (!(def->dt >= 0) || !(def->dt_safety > 0 && def->dt_safety <= 1))
+        return fail(err, errlen, "dt must be >= 0 and dt_safety in (0, 1]");
+    if (def->collision_steps < 1 || !(def->cg_tolerance > 0) || def->cg_max_iterations < 1)
+        return fail(err, errlen, "collision_steps, cg_tolerance and cg_max_iterations must be positive");
+    if (!finite3(def->gravity))
+        return fail(err, errlen, "gravity must be finite");
+    for (int c = 0; c < def->ncloths; c++) {
+        const cs_cloth_def *cl = def->cloths + c;
+        const cs_cloth_material *m = &cl->material;
+        if (!cl->mesh || cl->mesh->nv < 1)
+            return fail(err, errlen, "cloth %d has no vertices", c);
+        if (!(m->node_mass > 0) || !(m->density >= 0) || !(m->edge_stiffness >= 0) ||
+            !(m->bend_stiffness >= 0) || !(m->edge_overdamping >= 0) || !(m->bend_overdamping >= 0))
+            return fail(err, errlen, "cloth %d: mass must be > 0, stiffness and damping >= 0", c);
+        for (int k = 0; k < 3 * cl->mesh->nv; k++)
+            if (!isfinite(cl->mesh->x[k]))
+                return fail(err, errlen, "cloth %d: vertex %d is not finite", c, k / 3);
+        for (int k = 0; k < 3 * cl->mesh->nt; k++)
+            if (cl->mesh->tri[k] < 0 || cl->mesh->tri[k] >= cl->mesh->nv)
+                return fail(err, errlen, "cloth %d: triangle %d refers to a missing vertex", c, k / 3);
+        for (int s = 0; s < cl->nscripts; s++)
+            for (int k = 0; k < cl->scripts[s].nvertices; k++)
+                if (cl->scripts[s].vertices[k] < 0 || cl->scripts[s].vertices[k] >= cl->mesh->nv)
+                    return fail(err, errlen, "cloth %d: script %d selects a missing vertex", c, s);
+    }
+    for (int b = 0; b < def->nbodies; b++) {
+        const cs_body_def *body = def->bodies + b;
+        if ((unsigned)body->shape >= CS_BODY_SHAPE_COUNT)
+            return fail(err, errlen, "body %d: unknown shape", b);
+        if (!(body->friction >= 0))
+            return fail(err, errlen, "body %d: friction must be >= 0", b);
+    }
+    return CS_OK;
+}
+
+static int copy_motion(cs_motion *dst, const cs_motion *src)
+{
+    *dst = *src;
+    dst->keys = NULL;
+    if (src->kind == CS_MOTION_KEYFRAMES && src->nkeys > 0) {
+        cs_keyframe *k = malloc(sizeof *k * (size_t)src->nkeys);
+        if (!k)
+            return -1;
+        memcpy(k, src->keys, sizeof *k * (size_t)src->nkeys);
+        dst->keys = k;
+    } else {
+        dst->nkeys = 0;
+    }
+    return 0;
+}
+
+static double *alloc3(int n) { return calloc((size_t)n * 3 + 3, sizeof(double)); }
+
+/* Vertex masses: the node mass, or a third of the area of the adjacent
+ * triangles times the areal density. */
+static void cloth_masses(const cs_cloth_def *cl, double *mass)
+{
+    const cs_trimesh *m = cl->mesh;
+    for (int i = 0; i < m->nv; i++)
+        mass[i] = cl->material.density > 0 ? 0 : cl->material.node_mass;
+    if (!(cl->material.density > 0))
+        return;
+    for (int t = 0; t < m->nt; t++) {
+        const int *tri = m->tri + 3 * t;
+        double e1[3], e2[3], c[3];
+        cs_sub(m->x + 3 * tri[1], m->x + 3 * tri[0], e1);
+        cs_sub(m->x + 3 * tri[2], m->x + 3 * tri[0], e2);
+        cs_cross(e1, e2, c);
+        double share = cl->material.density * 0.5 * cs_norm(c) / 3.0;
+        for (int k = 0; k < 3; k++)
+            mass[tri[k]] += share;
+    }
+    for (int i = 0; i < m->nv; i++) /* lone or degenerate vertices */
+        if (!(mass[i] > 0))
+            mass[i] = cl->material.node_mass;
+}
+
+cs_sim *cs_sim_create(const cs_sim_def *def, char *err, size_t errlen)
+{
+    if (validate(def, err, errlen) != CS_OK)
+        return NULL;
+    cs_sim *sim = calloc(1, sizeof *sim);
+    if (!sim)
+        return NULL;
+    sim->def = *def;
+    sim->plan = cs_plan_from_def(def);
+    sim->def.cloths = NULL;
+    sim->def.bodies = NULL;
+
+    int n = 0;
+    for (int c = 0; c < def->ncloths; c++)
+        n += def->cloths[c].mesh->nv;
+    sim->n = n;
+    sim->x = alloc3(n);
+    sim->v = alloc3(n);
+    sim->mass = calloc((size_t)n + 1, sizeof *sim->mass);
+    sim->is_free = calloc((size_t)n + 1, 1);
+    sim->mode = calloc((size_t)n + 1, 1);
+    sim->cloths = calloc((size_t)def->ncloths, sizeof *sim->cloths);
+    sim->x_prev = alloc3(n);
+    sim->v_half = alloc3(n);
+    sim->v_star = alloc3(n);
+    sim->v_next = alloc3(n);
+    sim->force = alloc3(n);
+    sim->v0 = alloc3(n);
+    sim->rhs = alloc3(n);
+    double **cg[] = {&sim->cg.z, &sim->cg.r, &sim->cg.y, &sim->cg.p,
+                     &sim->cg.q, &sim->cg.diag, &sim->cg.b};
+    bool ok = sim->x && sim->v && sim->mass && sim->is_free && sim->mode && sim->cloths &&
+              sim->x_prev && sim->v_half && sim->v_star && sim->v_next && sim->force &&
+              sim->v0 && sim->rhs;
+    for (size_t k = 0; k < sizeof cg / sizeof *cg && ok; k++)
+        ok = (*cg[k] = alloc3(n)) != NULL;
+    if (!ok)
+        goto nomem;
+
+    /* particles, cloth by cloth */
+    sim->ncloths = def->ncloths;
+    int offset = 0;
+    for (int c = 0; c < def->ncloths; c++) {
+        const cs_cloth_def *cl = def->cloths + c;
+        const cs_trimesh *m = cl->mesh;
+        cs_cloth_state *cs = sim->cloths + c;
+        cs->offset = offset;
+        cs->name = strdup(cl->name ? cl->name : "cloth");
+        cs->mesh = cs_trimesh_create(m->nv, m->nt);
+        if (!cs->name || !cs->mesh)
+            goto nomem;
+        memcpy(cs->mesh->x, m->x, sizeof *m->x * 3 * (size_t)m->nv);
+        memcpy(cs->mesh->tri, m->tri, sizeof *m->tri * 3 * (size_t)m->nt);
+        memcpy(sim->x + 3 * offset, m->x, sizeof *m->x * 3 * (size_t)m->nv);
+        cloth_masses(cl, sim->mass + offset);
+        for (int i = 0; i < m->nv; i++) {
+            memcpy(sim->v + 3 * (offset + i), cl->velocity, 3 * sizeof(double));
+            sim->is_free[offset + i] = 1;
+        }
+        if (cs_springs_add_mesh(&sim->springs, offset, m->nv, m->nt, m->tri, sim->x + 3 * offset,
+                                sim->mass, cl->material.edge_stiffness,
+                                cl->material.edge_overdamping, cl->material.bend_stiffness,
+                                cl->material.bend_overdamping))
+            goto nomem;
+        /* springs_add_mesh indexes mass globally: it was given sim->mass and
+         * global ends, positions offset to this cloth */
+        sim->nscripts += cl->nscripts;
+        offset += m->nv;
+    }
+
+    /* pinned and scripted vertices */
+    if (sim->nscripts > 0) {
+        sim->scripts = calloc((size_t)sim->nscripts, sizeof *sim->scripts);
+        sim->script_x = alloc3(n);
+        sim->script_v = alloc3(n);
+        if (!sim->scripts || !sim->script_x || !sim->script_v)
+            goto nomem;
+        sim->stage_bytes[CS_STAGE_SCRIPTED_VERTICES] += 2 * 3 * sizeof(double) * (size_t)n;
+        int s = 0;
+        for (int c = 0; c < def->ncloths; c++) {
+            const cs_cloth_def *cl = def->cloths + c;
+            for (int k = 0; k < cl->nscripts; k++, s++) {
+                const cs_vertex_script *src = cl->scripts + k;
+                cs_script_state *dst = sim->scripts + s;
+                if (copy_motion(&dst->motion, &src->motion))
+                    goto nomem;
+                double c0[3];
+                cs_motion_pose(&dst->motion, 0.0, dst->rotation0, c0, NULL, NULL);
+                dst->nvertices = src->nvertices;
+                dst->vertices = malloc(sizeof *dst->vertices * (size_t)(src->nvertices + 1));
+                dst->local = alloc3(src->nvertices);
+                if (!dst->vertices || !dst->local)
+                    goto nomem;
+                sim->stage_bytes[CS_STAGE_SCRIPTED_VERTICES] +=
+                    (sizeof(int) + 3 * sizeof(double)) * (size_t)src->nvertices;
+                for (int j = 0; j < src->nvertices; j++) {
+                    int g = sim->cloths[c].offset + src->vertices[j];
+                    double rel[3];
+                    dst->vertices[j] = g;
+                    cs_sub(sim->x + 3 * g, c0, rel);
+                    cs_mat_apply_transpose(dst->rotation0, rel, dst->local + 3 * j);
+                    sim->is_free[g] = 0;
+                }
+            }
+        }
+    }
+
+    /* bodies, and the arrays only their stages use */
+    sim->nbodies = def->nbodies;
+    if (def->nbodies > 0) {
+        sim->bodies = calloc((size_t)def->nbodies, sizeof *sim->bodies);
+        if (!sim->bodies)
+            goto nomem;
+        for (int b = 0; b < def->nbodies; b++) {
+            sim->bodies[b] = def->bodies[b];
+            sim->bodies[b].name = NULL; /* names stay with the caller */
+            if (copy_motion(&sim->bodies[b].motion, &def->bodies[b].motion))
+                goto nomem;
+        }
+    }
+    if (cs_plan_has(&sim->plan, CS_STAGE_BODY_COLLISION)) {
+        sim->contact_normal = alloc3(n);
+        sim->contact_body = calloc((size_t)n + 1, sizeof *sim->contact_body);
+        if (!sim->contact_normal || !sim->contact_body)
+            goto nomem;
+        sim->stage_bytes[CS_STAGE_BODY_COLLISION] = (3 * sizeof(double) + sizeof(int)) * (size_t)n;
+    }
+    if (cs_plan_has(&sim->plan, CS_STAGE_WIND)) {
+        sim->wind_normal = alloc3(n);
+        sim->wind_area = calloc((size_t)n + 1, sizeof *sim->wind_area);
+        if (!sim->wind_normal || !sim->wind_area)
+            goto nomem;
+        sim->stage_bytes[CS_STAGE_WIND] = 4 * sizeof(double) * (size_t)n;
+    }
+
+    /* time step: the explicit elastic forces are stable for dt < 2 / omega_max
+     * (the scheme's amplification matrix has determinant 1 and trace
+     * 2 - dt^2 omega^2); omega_max^2 is bounded by Gershgorin. */
+    double bound = cs_springs_stiffness_bound(&sim->springs, sim->mass, sim->is_free, n);
+    double frame = 1.0 / def->fps;
+    sim->stable_dt = bound > 0 ? 2.0 / sqrt(bound) : INFINITY;
+    double dt_max = def->dt > 0 ? def->dt : def->dt_safety * sim->stable_dt;
+    if (dt_max > frame)
+        dt_max = frame;
+    int steps = (int)ceil(frame / dt_max - 1e-9);
+    sim->dt = frame / (steps > 0 ? steps : 1);
+    return sim;
+
+nomem:
+    fail(err, errlen, "out of memory creating a simulation of %d particles", n);
+    cs_sim_destroy(sim);
+    return NULL;
+}
+
+void cs_sim_destroy(cs_sim *sim)
+{
+    if (!sim)
+        return;
+    for (int c = 0; c < sim->ncloths && sim->cloths; c++) {
+        free(sim->cloths[c].name);
+        cs_trimesh_destroy(sim->cloths[c].mesh);
+    }
+    free(sim->cloths);
+    for (int s = 0; s < sim->nscripts && sim->scripts; s++) {
+        free((void *)sim->scripts[s].motion.keys);
+        free(sim->scripts[s].vertices);
+        free(sim->scripts[s].local);
+    }
+    free(sim->scripts);
+    for (int b = 0; b < sim->nbodies && sim->bodies; b++)
+        free((void *)sim->bodies[b].motion.keys);
+    free(sim->bodies);
+    cs_springs_free(&sim->springs);
+    double *arrays[] = {sim->x, sim->v, sim->mass, sim->x_prev, sim->v_half, sim->v_star,
+                        sim->v_next, sim->force, sim->v0, sim->rhs, sim->script_x,
+                        sim->script_v, sim->contact_normal, sim->wind_normal, sim->wind_area,
+                        sim->cg.z, sim->cg.r, sim->cg.y, sim->cg.p, sim->cg.q, sim->cg.diag,
+                        sim->cg.b};
+    for (size_t k = 0; k < sizeof arrays / sizeof *arrays; k++)
+        free(arrays[k]);
+    free(sim->is_free);
+    free(sim->mode);
+    free(sim->contact_body);
+    free(sim);
+}
+
+/* Targets of scripted vertices at time t: position and velocity. */
+static void script_targets(cs_sim *sim, double t)
+{
+    for (int s = 0; s < sim->nscripts; s++) {
+        cs_script_state *sc = sim->scripts + s;
+        double R[9], c[3], vel[3], w[3];
+        cs_motion_pose(&sc->motion, t, R, c, vel, w);
+        for (int j = 0; j < sc->nvertices; j++) {
+            int g = sc->vertices[j];
+            double r[3], wr[3];
+            cs_mat_apply(R, sc->local + 3 * j, r);
+            cs_cross(w, r, wr);
+            for (int d = 0; d < 3; d++) {
+                sim->script_x[3 * g + d] = c[d] + r[d];
+                sim->script_v[3 * g + d] = vel[d] + wr[d];
+            }
+        }
+    }
+}
+
+/* Area-weighted vertex normals and a third of the adjacent area. */
+static void wind_geometry(cs_sim *sim, const double *x)
+{
+    memset(sim->wind_normal, 0, sizeof(double) * 3 * (size_t)sim->n);
+    memset(sim->wind_area, 0, sizeof(double) * (size_t)sim->n);
+    for (int c = 0; c < sim->ncloths; c++) {
+        const cs_trimesh *m = sim->cloths[c].mesh;
+        int off = sim->cloths[c].offset;
+        for (int t = 0; t < m->nt; t++) {
+            int a = off + m->tri[3 * t], b = off + m->tri[3 * t + 1], cc = off + m->tri[3 * t + 2];
+            double e1[3], e2[3], cr[3];
+            cs_sub(x + 3 * b, x + 3 * a, e1);
+            cs_sub(x + 3 * cc, x + 3 * a, e2);
+            cs_cross(e1, e2, cr); /* |cr| = twice the area */
+            int v[3] = {a, b, cc};
+            for (int k = 0; k < 3; k++) {
+                cs_axpy(1.0, cr, sim->wind_normal + 3 * v[k]);
+                sim->wind_area[v[k]] += cs_norm(cr) / 6.0;
+            }
+        }
+    }
+    for (int i = 0; i < sim->n; i++) {
+        double *nrm = sim->wind_normal + 3 * i, l = cs_norm(nrm);
+        if (l > 0)
+            for (int d = 0; d < 3; d++)
+                nrm[d] /= l;
+    }
+}
+
+/* force = elastic(x) + m g + explicit wind part, for free particles */
+static void explicit_forces(cs_sim *sim, const double *x)
+{
+    memset(sim->force, 0, sizeof(double) * 3 * (size_t)sim->n);
+    cs_springs_add_elastic(&sim->springs, x, sim->force);
+    for (int i = 0; i < sim->n; i++)
+        cs_axpy(sim->mass[i], sim->def.gravity, sim->force + 3 * i);
+    if (sim->wind_normal) {
+        double c = sim->def.wind.drag;
+        for (int i = 0; i < sim->n; i++) {
+            const double *nrm = sim->wind_normal + 3 * i;
+            cs_axpy(c * sim->wind_area[i] * cs_dot(nrm, sim->def.wind.velocity), nrm,
+                    sim->force + 3 * i);
+        }
+    }
+}
+
+/* rhs = M v_start + h force */
+static void momentum_rhs(cs_sim *sim, const double *v_start)
+{
+    for (int i = 0; i < sim->n; i++)
+        for (int d = 0; d < 3; d++)
+            sim->rhs[3 * i + d] = sim->mass[i] * v_start[3 * i + d] + sim->h * sim->force[3 * i + d];
+}
+
+int cs_sim_step(cs_sim *sim, double dt)
+{
+    int n = sim->n, n3 = 3 * n;
+    const cs_plan *plan = &sim->plan;
+    bool bodies = cs_plan_has(plan, CS_STAGE_BODY_COLLISION);
+    double t1 = sim->t + dt;
+    sim->h = 0.5 * dt;
+    memcpy(sim->x_prev, sim->x, sizeof(double) * (size_t)n3);
+    for (int i = 0; i < n; i++)
+        sim->mode[i] = sim->is_free[i] ? CS_FREE : CS_FIXED;
+
+    if (sim->nscripts > 0) {
+        STAGE_BEGIN(sim, CS_STAGE_SCRIPTED_VERTICES);
+        script_targets(sim, t1);
+        STAGE_END(sim, CS_STAGE_SCRIPTED_VERTICES);
+    }
+    if (sim->wind_normal) {
+        STAGE_BEGIN(sim, CS_STAGE_WIND);
+        wind_geometry(sim, sim->x);
+        STAGE_END(sim, CS_STAGE_WIND);
+    }
+
+    /* B.1: v~^(n+1/2) = v^n + dt/2 a(x^n, v~^(n+1/2)), unconstrained by
+     * contact (constraining it would make cloth stick to bodies). Scripted
+     * particles move straight to their targets. */
+    STAGE_BEGIN(sim, CS_STAGE_VELOCITY_HALF);
+    memcpy(sim->v0, sim->v, sizeof(double) * (size_t)n3);
+    for (int i = 0; i < n; i++)
+        if (!sim->is_free[i])
+            for (int d = 0; d < 3; d++)
+                sim->v0[3 * i + d] = (sim->script_x[3 * i + d] - sim->x[3 * i + d]) / dt;
+    explicit_forces(sim, sim->x);
+    cs_springs_prepare(&sim->springs, sim->x);
+    momentum_rhs(sim, sim->v);
+    sim->cg_iterations += cs_cg_solve(sim, sim->v0, sim->rhs, sim->v_half);
+    STAGE_END(sim, CS_STAGE_VELOCITY_HALF);
+
+    /* B.3 */
+    STAGE_BEGIN(sim, CS_STAGE_POSITION_UPDATE);
+    for (int k = 0; k < n3; k++)
+        sim->x[k] = sim->x_prev[k] + dt * sim->v_half[k];
+    for (int i = 0; i < n; i++) /* exact targets, free of round-off */
+        if (!sim->is_free[i])
+            memcpy(sim->x + 3 * i, sim->script_x + 3 * i, 3 * sizeof(double));
+    STAGE_END(sim, CS_STAGE_POSITION_UPDATE);
+
+    /* B.4 */
+    if (bodies) {
+        STAGE_BEGIN(sim, CS_STAGE_BODY_COLLISION);
+        cs_body_collide(sim, dt);
+        STAGE_END(sim, CS_STAGE_BODY_COLLISION);
+    } else {
+        memcpy(sim->v_star, sim->v, sizeof(double) * (size_t)n3);
+    }
+
+    /* B.5 and B.6: v^(n+1/2) = v*^n + dt/2 a(x^(n+1/2), v^(n+1/2)) with the
+     * normal velocity of contact particles held (P), then
+     * v^(n+1) = 2 v^(n+1/2) - v*^n. The improved method extrapolates from
+     * v_NP: the same forces, damping evaluated at the projected solution,
+     * applied without projection, so B.7 sees the normal force. */
+    STAGE_BEGIN(sim, CS_STAGE_VELOCITY_FULL);
+    for (int i = 0; i < n; i++)
+        if (!sim->is_free[i])
+            memcpy(sim->v_star + 3 * i, sim->v0 + 3 * i, 3 * sizeof(double));
+    for (int k = 0; k < n3; k++)
+        sim->v_half[k] = 0.5 * (sim->x_prev[k] + sim->x[k]); /* x^(n+1/2), reusing v_half */
+    explicit_forces(sim, sim->v_half);
+    cs_springs_prepare(&sim->springs, sim->v_half);
+    momentum_rhs(sim, sim->v_star);
+    double *v_p = sim->v0; /* v0 is free again */
+    memcpy(sim->cg.b, sim->v_star, sizeof(double) * (size_t)n3);
+    sim->cg_iterations += cs_cg_solve(sim, sim->cg.b, sim->rhs, v_p);
+    if (bodies && sim->def.friction_method == CS_FRICTION_IMPROVED) {
+        memcpy(sim->v_next, sim->force, sizeof(double) * (size_t)n3);
+        cs_damping_apply(sim, v_p, sim->v_next); /* F_i + F_d v_P */
+        for (int i = 0; i < n; i++)
+            for (int d = 0; d < 3; d++) {
+                int k = 3 * i + d;
+                double v_np = sim->v_star[k] + sim->h / sim->mass[i] * sim->v_next[k];
+                sim->v_next[k] = 2.0 * v_np - sim->v_star[k];
+            }
+    } else {
+        for (int k = 0; k < n3; k++)
+            sim->v_next[k] = 2.0 * v_p[k] - sim->v_star[k];
+    }
+    for (int i = 0; i < n; i++)
+        if (!sim->is_free[i])
+            memcpy(sim->v_next + 3 * i, sim->script_v + 3 * i, 3 * sizeof(double));
+    STAGE_END(sim, CS_STAGE_VELOCITY_FULL);
+
+    /* B.7 */
+    if (bodies) {
+        STAGE_BEGIN(sim, CS_STAGE_BODY_FRICTION);
+        cs_body_friction(sim, dt);
+        STAGE_END(sim, CS_STAGE_BODY_FRICTION);
+    }
+    memcpy(sim->v, sim->v_next, sizeof(double) * (size_t)n3);
+    sim->t = t1;
+
+    for (int k = 0; k < n3; k++)
+        if (!isfinite(sim->x[k]) || !isfinite(sim->v[k]))
+            return CS_ERR_UNSTABLE;
+    return CS_OK;
+}
+
+int cs_sim_advance_frame(cs_sim *sim, cs_frame_stats *stats)
+{
+    double frame = 1.0 / sim->def.fps;
+    int steps = (int)lround(frame / sim->dt);
+    long cg0 = sim->cg_iterations, contacts0 = sim->contacts;
+    int status = CS_OK;
+    /* The outer collision loop: k_i time steps, then (with self-collision,
+     * issue 3) step C. Chunks never straddle a frame end. */
+    for (int s = 0; s < steps && status == CS_OK;) {
+        int chunk = steps - s < sim->def.collision_steps ? steps - s : sim->def.collision_steps;
+        for (int k = 0; k < chunk && status == CS_OK; k++)
+            status = cs_sim_step(sim, sim->dt);
+        s += chunk;
+    }
+    if (stats) {
+        memset(stats, 0, sizeof *stats);
+        stats->steps = steps;
+        stats->dt = sim->dt;
+        stats->cg_iterations = sim->cg_iterations - cg0;
+        stats->body_contacts = sim->contacts - contacts0;
+        for (int i = 0; i < sim->n; i++) {
+            double s = cs_norm(sim->v + 3 * i);
+            if (s > stats->max_speed)
+                stats->max_speed = s;
+        }
+    }
+    return status;
+}
+
+double cs_sim_time(const cs_sim *sim) { return sim->t; }
+double cs_sim_dt(const cs_sim *sim) { return sim->dt; }
+double cs_sim_stable_dt(const cs_sim *sim) { return sim->stable_dt; }
+int cs_sim_particle_count(const cs_sim *sim) { return sim->n; }
+const double *cs_sim_positions(const cs_sim *sim) { return sim->x; }
+const double *cs_sim_velocities(const cs_sim *sim) { return sim->v; }
+const double *cs_sim_masses(const cs_sim *sim) { return sim->mass; }
+int cs_sim_cloth_count(const cs_sim *sim) { return sim->ncloths; }
+int cs_sim_cloth_offset(const cs_sim *sim, int c) { return sim->cloths[c].offset; }
+const cs_trimesh *cs_sim_cloth_mesh(const cs_sim *sim, int c) { return sim->cloths[c].mesh; }
+const char *cs_sim_cloth_name(const cs_sim *sim, int c) { return sim->cloths[c].name; }
+const cs_plan *cs_sim_plan(const cs_sim *sim) { return &sim->plan; }
+const cs_stage_timing *cs_sim_stage_timing(const cs_sim *sim) { return sim->timing; }
+size_t cs_sim_stage_bytes(const cs_sim *sim, cs_stage stage)
+{
+    return (unsigned)stage < CS_STAGE_COUNT ? sim->stage_bytes[stage] : 0;
+}

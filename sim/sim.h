@@ -1,0 +1,272 @@
+/* sim.h: the public face of the simulation core.
+ *
+ * The core is plain C11 and knows no files and no pixels. A caller fills the
+ * definition structs below (starting from the cs_default_* functions, which
+ * hold the paper's Table 1), creates a cs_sim, advances it frame by frame and
+ * reads positions, counters and the timing table back.
+ *
+ * Units are SI throughout: metres, seconds, kilograms, newtons, radians.
+ */
+#ifndef CS_SIM_H
+#define CS_SIM_H
+
+#include <stdbool.h>
+#include <stddef.h>
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* ---------------------------------------------------------------- status */
+
+/* Every fallible call returns CS_OK or a negative code and, where a message
+ * buffer is given, a sentence that says what was wrong. */
+enum {
+    CS_OK = 0,
+    CS_ERR_INVALID = -1,   /* a definition that makes no sense */
+    CS_ERR_NOMEM = -2,
+    CS_ERR_UNSTABLE = -3,  /* NaN or runaway velocity detected */
+};
+
+/* -------------------------------------------------------------- geometry */
+
+/* A triangle mesh: nv vertices (3 doubles each), nt triangles (3 ints each). */
+typedef struct cs_trimesh {
+    int nv, nt;
+    double *x;
+    int *tri;
+} cs_trimesh;
+
+cs_trimesh *cs_trimesh_create(int nv, int nt);
+void cs_trimesh_destroy(cs_trimesh *mesh);
+
+/* A rectangle of size[0] x size[1] metres split into res[0] x res[1] quads
+ * (two triangles each, diagonals alternating so the grid has no preferred
+ * shear direction). It lies in the local x-z plane centred at the origin
+ * (normal +y); rotate (a unit quaternion w,x,y,z) then center place it.
+ * Vertex (i, j), i along x and j along z, has index j * (res[0] + 1) + i. */
+cs_trimesh *cs_trimesh_create_grid(const double size[2], const int res[2],
+                                   const double rotate[4], const double center[3]);
+
+/* ---------------------------------------------------------------- motion */
+
+/* One key of a keyframed rigid motion: at `time` the object's frame sits at
+ * `position` with orientation `rotation` (unit quaternion w,x,y,z).
+ * Between keys position is interpolated linearly and rotation by slerp, so
+ * linear and angular velocity are constant on each interval. */
+typedef struct cs_keyframe {
+    double time;
+    double position[3];
+    double rotation[4];
+} cs_keyframe;
+
+typedef enum cs_motion_kind {
+    CS_MOTION_STATIC = 0,   /* stays at position/rotation */
+    CS_MOTION_CONSTANT,     /* constant linear and angular velocity */
+    CS_MOTION_KEYFRAMES,    /* piecewise linear / slerp between keys */
+} cs_motion_kind;
+
+/* A rigid motion of a frame over time. A point p given in the frame's local
+ * coordinates is at  c(t) + R(t) p  in the world at time t. */
+typedef struct cs_motion {
+    cs_motion_kind kind;
+    double position[3];          /* c(0) */
+    double rotation[4];          /* R(0) as a unit quaternion w,x,y,z */
+    double velocity[3];          /* CS_MOTION_CONSTANT: dc/dt */
+    double angular_velocity[3];  /* CS_MOTION_CONSTANT: world axis * rad/s */
+    int nkeys;                   /* CS_MOTION_KEYFRAMES */
+    const cs_keyframe *keys;     /* sorted by time; copied by cs_sim_create */
+} cs_motion;
+
+/* The identity motion: static at the origin. */
+cs_motion cs_motion_static(void);
+
+/* Pose at time t: rotation matrix R (row-major 3x3), origin c, and the
+ * frame's linear velocity dc/dt and angular velocity omega. Any output
+ * pointer may be NULL. */
+void cs_motion_pose(const cs_motion *m, double t, double R[9], double c[3],
+                    double velocity[3], double omega[3]);
+
+/* ---------------------------------------------------------------- bodies */
+
+typedef enum cs_body_shape {
+    CS_BODY_PLANE = 0,   /* local plane y = 0, outside is +y */
+    CS_BODY_SPHERE,      /* radius, centred at the local origin */
+    CS_BODY_BOX,         /* half_extents, centred at the local origin */
+    CS_BODY_CYLINDER,    /* radius, half_height, axis local y, capped */
+    CS_BODY_SHAPE_COUNT
+} cs_body_shape;
+
+/* A signed distance queried in the body's local frame: returns phi and writes
+ * the unit gradient. Grid bodies (level sets from meshes) plug in here. */
+typedef double (*cs_body_phi_fn)(const void *data, const double p[3], double grad[3]);
+
+typedef struct cs_body_def {
+    const char *name;
+    cs_body_shape shape;
+    double radius;
+    double half_extents[3];
+    double half_height;
+    double friction;          /* Coulomb coefficient mu */
+    cs_motion motion;         /* where the local frame is over time */
+    /* Optional: a user distance function replacing the analytic shape. */
+    cs_body_phi_fn phi_fn;
+    const void *phi_data;
+} cs_body_def;
+
+cs_body_def cs_default_body_def(void);
+
+/* Signed distance and unit gradient of a body at world point x, time t. */
+double cs_body_def_phi(const cs_body_def *b, double t, const double x[3], double grad[3]);
+
+/* Velocity at time t of the body material point at world position x. */
+void cs_body_def_velocity(const cs_body_def *b, double t, const double x[3], double v[3]);
+
+/* ---------------------------------------------------------------- cloth */
+
+/* The paper's Table 1. Stiffnesses are Young's moduli of the spring force
+ * law F = E (|u|/|u0| - 1), so they are forces (N). */
+typedef struct cs_cloth_material {
+    double edge_stiffness;     /* E_e, N           (4.14) */
+    double edge_overdamping;   /* xi_e             (15)   */
+    double bend_stiffness;     /* E_b, N           (0.41) */
+    double bend_overdamping;   /* xi_b             (8)    */
+    double node_mass;          /* kg per vertex    (1e-6), used when density == 0 */
+    double density;            /* kg/m^2 areal density; > 0 overrides node_mass */
+} cs_cloth_material;
+
+cs_cloth_material cs_default_cloth_material(void);
+
+/* A set of cloth vertices whose positions are prescribed: pinned (static
+ * motion) or moved by a script. Vertex positions at time 0 are taken as the
+ * frame's local coordinates relative to motion.position, i.e. a vertex at
+ * world x0 is at c(t) + R(t) R(0)^T (x0 - c(0)) at time t. */
+typedef struct cs_vertex_script {
+    int nvertices;
+    const int *vertices;      /* indices into the cloth's mesh */
+    cs_motion motion;
+} cs_vertex_script;
+
+typedef struct cs_cloth_def {
+    const char *name;
+    const cs_trimesh *mesh;   /* copied by cs_sim_create */
+    cs_cloth_material material;
+    double velocity[3];       /* initial velocity of every vertex */
+    int nscripts;
+    const cs_vertex_script *scripts;
+} cs_cloth_def;
+
+/* --------------------------------------------------------------- the run */
+
+typedef enum cs_friction_method {
+    CS_FRICTION_IMPROVED = 0,  /* Section 6: crossing point, Gamma, v_NP */
+    CS_FRICTION_PROJECTION,    /* Bridson et al. 2003: project along normal */
+} cs_friction_method;
+
+/* Linear drag along the normal (Section 8): each vertex feels
+ * F = -drag * area_i * ((v - wind) . n) n, with area_i a third of the area
+ * of its triangles, so drag has units N s / m^3. */
+typedef struct cs_wind_def {
+    double velocity[3];
+    double drag;
+} cs_wind_def;
+
+typedef struct cs_sim_def {
+    double gravity[3];
+    double fps;                /* frames per second of output */
+    double dt;                 /* > 0: fixed step; 0: automatic from stability */
+    double dt_safety;          /* fraction of the stability limit used (auto) */
+    int collision_steps;       /* k_i: time steps per outer collision loop */
+    double cg_tolerance;       /* m/s, max norm of the velocity residual */
+    int cg_max_iterations;
+    cs_friction_method friction_method;
+    bool bodies_enabled;       /* effects: body collisions and friction */
+    bool wind_enabled;         /* effects: wind drag */
+    bool self_collision;       /* effects: repulsions and collisions (issue 3) */
+    cs_wind_def wind;
+    int ncloths;
+    const cs_cloth_def *cloths;
+    int nbodies;
+    const cs_body_def *bodies;
+} cs_sim_def;
+
+cs_sim_def cs_default_sim_def(void);
+
+/* ------------------------------------------------------- plan and timing */
+
+/* The stages a step can contain, in the order they run. A plan holds only
+ * the ones the scene calls for; the others are neither run nor allocated. */
+typedef enum cs_stage {
+    CS_STAGE_SCRIPTED_VERTICES = 0, /* prescribed positions and velocities */
+    CS_STAGE_WIND,                  /* normals and areas for wind drag */
+    CS_STAGE_VELOCITY_HALF,         /* B.1 backward Euler half step (CG) */
+    CS_STAGE_POSITION_UPDATE,       /* B.3 */
+    CS_STAGE_BODY_COLLISION,        /* B.4 crossing point, Gamma */
+    CS_STAGE_VELOCITY_FULL,         /* B.5 projected solve (CG), B.6 */
+    CS_STAGE_BODY_FRICTION,         /* B.7 Gamma on v_NP */
+    CS_STAGE_COUNT
+} cs_stage;
+
+const char *cs_stage_name(cs_stage stage);
+const char *cs_stage_description(cs_stage stage);
+
+typedef struct cs_plan {
+    int nstages;
+    cs_stage stages[CS_STAGE_COUNT];
+} cs_plan;
+
+/* What the scene definition calls for, without creating anything. */
+cs_plan cs_plan_from_def(const cs_sim_def *def);
+bool cs_plan_has(const cs_plan *plan, cs_stage stage);
+
+typedef struct cs_stage_timing {
+    double seconds;
+    long calls;
+} cs_stage_timing;
+
+/* Counters for one frame. */
+typedef struct cs_frame_stats {
+    int steps;
+    double dt;
+    long cg_iterations;
+    long body_contacts;        /* particle-steps in contact with a body */
+    double max_speed;          /* m/s at the end of the frame */
+} cs_frame_stats;
+
+/* ------------------------------------------------------------ simulation */
+
+typedef struct cs_sim cs_sim;
+
+/* Creates the simulation; on failure returns NULL and writes why into err. */
+cs_sim *cs_sim_create(const cs_sim_def *def, char *err, size_t errlen);
+void cs_sim_destroy(cs_sim *sim);
+
+/* Advances one frame (1/fps seconds). Returns CS_OK or CS_ERR_UNSTABLE. */
+int cs_sim_advance_frame(cs_sim *sim, cs_frame_stats *stats);
+
+/* Advances by exactly one time step of the integrator (for tests). */
+int cs_sim_step(cs_sim *sim, double dt);
+
+double cs_sim_time(const cs_sim *sim);
+double cs_sim_dt(const cs_sim *sim);          /* step used by advance_frame */
+double cs_sim_stable_dt(const cs_sim *sim);   /* stability estimate */
+int cs_sim_particle_count(const cs_sim *sim);
+const double *cs_sim_positions(const cs_sim *sim);
+const double *cs_sim_velocities(const cs_sim *sim);
+const double *cs_sim_masses(const cs_sim *sim);
+int cs_sim_cloth_count(const cs_sim *sim);
+/* Particles of cloth c are [offset, offset + mesh->nv); triangle indices in
+ * mesh->tri are local to the cloth. */
+int cs_sim_cloth_offset(const cs_sim *sim, int c);
+const cs_trimesh *cs_sim_cloth_mesh(const cs_sim *sim, int c);
+const char *cs_sim_cloth_name(const cs_sim *sim, int c);
+
+const cs_plan *cs_sim_plan(const cs_sim *sim);
+const cs_stage_timing *cs_sim_stage_timing(const cs_sim *sim); /* CS_STAGE_COUNT entries */
+/* Bytes the simulation allocated for a stage's own data (0 if absent). */
+size_t cs_sim_stage_bytes(const cs_sim *sim, cs_stage stage);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

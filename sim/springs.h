@@ -1,0 +1,49 @@
+/* springs.h: the mass-spring model of Section 3, private to sim/.
+ *
+ * Edge springs join the two ends of every mesh edge; bending springs join the
+ * two unshared vertices of every pair of triangles sharing an edge (Fig. 4).
+ * The force on particle i of a spring (i, j), u = x_j - x_i, is
+ *   f_i = [E (|u|/L0 - 1) + d (v_j - v_i) . u_hat] u_hat,   f_j = -f_i.
+ * (The paper writes the damping term with V1 - V2; with u = X2 - X1 that
+ * sign would add energy, so we use the dissipative one.)
+ */
+#ifndef CS_SPRINGS_H
+#define CS_SPRINGS_H
+
+#include <stddef.h>
+
+typedef struct cs_springs {
+    int n, capacity;
+    int *ends;           /* 2 per spring: i, j (global particle indices) */
+    double *rest_length; /* L0 */
+    double *stiffness;   /* E, N */
+    double *damping;     /* d, N s / m */
+    double *direction;   /* 3 per spring: u_hat at the last cs_springs_prepare */
+    int nedge;           /* the first nedge springs are edge springs */
+    int skipped;         /* degenerate (zero rest length) springs left out */
+} cs_springs;
+
+/* Appends the edge and bending springs of a triangle mesh whose vertices are
+ * particles [offset, offset + nv). Stiffness, overdamping fractions and
+ * masses give E and d (d = xi * 2 sqrt(E m_reduced / L0)). Returns 0 or -1
+ * on allocation failure. */
+int cs_springs_add_mesh(cs_springs *s, int offset, int nv, int nt, const int *tri,
+                        const double *x, const double *mass,
+                        double edge_E, double edge_xi, double bend_E, double bend_xi);
+void cs_springs_free(cs_springs *s);
+
+/* Elastic forces only (the explicit part), added into f. */
+void cs_springs_add_elastic(const cs_springs *s, const double *x, double *f);
+/* Stores u_hat of every spring at positions x for the damping operator. */
+void cs_springs_prepare(cs_springs *s, const double *x);
+/* out += D v, the damping force (D is the velocity Jacobian, symmetric
+ * negative semi-definite), with the directions from cs_springs_prepare. */
+void cs_springs_add_damping(const cs_springs *s, const double *v, double *out);
+/* diag += -diag(D) per coordinate, for the Jacobi preconditioner. */
+void cs_springs_add_damping_diagonal(const cs_springs *s, double *diag);
+/* Largest eigenvalue bound (Gershgorin) of M^-1 K_elastic over particles
+ * with is_free[i] set: per particle 2 * sum(E/L0) / m. */
+double cs_springs_stiffness_bound(const cs_springs *s, const double *mass,
+                                  const unsigned char *is_free, int nparticles);
+
+#endif

@@ -1,0 +1,478 @@
+/* Unit tests of the simulation core: spring forces and their damping
+ * Jacobian against finite differences, the CG solve against a dense
+ * factorisation, bodies' phi and grad phi, Gamma in each friction regime,
+ * motions, the plan of stages, and the automatic time step. */
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <setjmp.h>
+#include <cmocka.h>
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "sim/internal.h"
+#include "sim/vec3.h"
+
+static double frand(unsigned *seed)
+{
+    *seed = *seed * 1103515245u + 12345u;
+    return ((*seed >> 8) & 0xffff) / 65535.0 * 2.0 - 1.0;
+}
+
+/* A small jittered grid cloth definition; the mesh is returned for freeing. */
+static cs_sim_def grid_def(cs_cloth_def *cloth, cs_trimesh **mesh, int res, unsigned seed)
+{
+    double size[2] = {1, 1}, q[4] = {1, 0, 0, 0}, c[3] = {0, 1, 0};
+    int r[2] = {res, res};
+    *mesh = cs_trimesh_create_grid(size, r, q, c);
+    for (int k = 0; k < 3 * (*mesh)->nv; k++)
+        (*mesh)->x[k] += 0.01 * frand(&seed);
+    memset(cloth, 0, sizeof *cloth);
+    cloth->name = "grid";
+    cloth->mesh = *mesh;
+    cloth->material = cs_default_cloth_material();
+    cs_sim_def def = cs_default_sim_def();
+    def.ncloths = 1;
+    def.cloths = cloth;
+    return def;
+}
+
+static double spring_energy(const cs_springs *s, const double *x)
+{
+    double e = 0;
+    for (int k = 0; k < s->n; k++) {
+        double u[3];
+        cs_sub(x + 3 * s->ends[2 * k + 1], x + 3 * s->ends[2 * k], u);
+        double l = cs_norm(u), L0 = s->rest_length[k];
+        e += 0.5 * s->stiffness[k] / L0 * (l - L0) * (l - L0);
+    }
+    return e;
+}
+
+static void test_spring_force_is_minus_energy_gradient(void **state)
+{
+    (void)state;
+    cs_cloth_def cloth;
+    cs_trimesh *mesh;
+    cs_sim_def def = grid_def(&cloth, &mesh, 3, 7);
+    cs_sim *sim = cs_sim_create(&def, NULL, 0);
+    assert_non_null(sim);
+    assert_true(sim->springs.n > sim->springs.nedge); /* bending springs exist */
+    unsigned seed = 3;
+    for (int k = 0; k < 3 * sim->n; k++) /* deform: stretch some, squash others */
+        sim->x[k] += 0.02 * frand(&seed);
+    double *f = calloc(3 * (size_t)sim->n, sizeof *f);
+    cs_springs_add_elastic(&sim->springs, sim->x, f);
+    double eps = 1e-7, worst = 0, scale = 0;
+    for (int k = 0; k < 3 * sim->n; k++) {
+        double keep = sim->x[k];
+        sim->x[k] = keep + eps;
+        double ep = spring_energy(&sim->springs, sim->x);
+        sim->x[k] = keep - eps;
+        double em = spring_energy(&sim->springs, sim->x);
+        sim->x[k] = keep;
+        double fd = -(ep - em) / (2 * eps);
+        worst = fmax(worst, fabs(fd - f[k]));
+        scale = fmax(scale, fabs(f[k]));
+    }
+    assert_true(scale > 1e-3);
+    assert_true(worst < 1e-6 * scale + 1e-9);
+    free(f);
+    cs_sim_destroy(sim);
+    cs_trimesh_destroy(mesh);
+}
+
+/* total spring force (elastic + damping) for positions x, velocities v */
+static void spring_force(cs_sim *sim, const double *v, double *f)
+{
+    memset(f, 0, sizeof *f * 3 * (size_t)sim->n);
+    cs_springs_add_elastic(&sim->springs, sim->x, f);
+    cs_springs_prepare(&sim->springs, sim->x);
+    cs_springs_add_damping(&sim->springs, v, f);
+}
+
+static void test_damping_jacobian_matches_finite_differences(void **state)
+{
+    (void)state;
+    cs_cloth_def cloth;
+    cs_trimesh *mesh;
+    cs_sim_def def = grid_def(&cloth, &mesh, 3, 11);
+    cs_sim *sim = cs_sim_create(&def, NULL, 0);
+    assert_non_null(sim);
+    int n3 = 3 * sim->n;
+    unsigned seed = 5;
+    double *v = calloc((size_t)n3, sizeof *v), *fp = calloc((size_t)n3, sizeof *fp),
+           *fm = calloc((size_t)n3, sizeof *fm), *e = calloc((size_t)n3, sizeof *e),
+           *De = calloc((size_t)n3, sizeof *De);
+    for (int k = 0; k < n3; k++) {
+        v[k] = frand(&seed);
+        sim->x[k] += 0.02 * frand(&seed);
+    }
+    double eps = 1e-6, worst = 0, scale = 0;
+    for (int col = 0; col < n3; col++) {
+        v[col] += eps;
+        spring_force(sim, v, fp);
+        v[col] -= 2 * eps;
+        spring_force(sim, v, fm);
+        v[col] += eps;
+        memset(e, 0, sizeof *e * (size_t)n3);
+        memset(De, 0, sizeof *De * (size_t)n3);
+        e[col] = 1;
+        cs_springs_add_damping(&sim->springs, e, De);
+        for (int row = 0; row < n3; row++) {
+            double fd = (fp[row] - fm[row]) / (2 * eps);
+            worst = fmax(worst, fabs(fd - De[row]));
+            scale = fmax(scale, fabs(De[row]));
+        }
+        assert_true(De[col] <= 0); /* D is negative semi-definite */
+    }
+    assert_true(scale > 0);
+    assert_true(worst < 1e-6 * scale);
+    free(v), free(fp), free(fm), free(e), free(De);
+    cs_sim_destroy(sim);
+    cs_trimesh_destroy(mesh);
+}
+
+/* Dense Gaussian elimination with partial pivoting, for reference. */
+static void dense_solve(int n, double *A, double *b)
+{
+    for (int c = 0; c < n; c++) {
+        int p = c;
+        for (int r = c + 1; r < n; r++)
+            if (fabs(A[r * n + c]) > fabs(A[p * n + c]))
+                p = r;
+        for (int k = 0; k < n; k++) {
+            double t = A[c * n + k];
+            A[c * n + k] = A[p * n + k];
+            A[p * n + k] = t;
+        }
+        double t = b[c];
+        b[c] = b[p];
+        b[p] = t;
+        for (int r = c + 1; r < n; r++) {
+            double f = A[r * n + c] / A[c * n + c];
+            for (int k = c; k < n; k++)
+                A[r * n + k] -= f * A[c * n + k];
+            b[r] -= f * b[c];
+        }
+    }
+    for (int r = n - 1; r >= 0; r--) {
+        for (int k = r + 1; k < n; k++)
+            b[r] -= A[r * n + k] * b[k];
+        b[r] /= A[r * n + r];
+    }
+}
+
+static void test_cg_matches_dense_solve(void **state)
+{
+    (void)state;
+    cs_cloth_def cloth;
+    cs_trimesh *mesh;
+    cs_sim_def def = grid_def(&cloth, &mesh, 4, 13);
+    def.cg_tolerance = 1e-12;
+    cs_sim *sim = cs_sim_create(&def, NULL, 0);
+    assert_non_null(sim);
+    int n3 = 3 * sim->n;
+    sim->h = 0.5e-3;
+    cs_springs_prepare(&sim->springs, sim->x);
+    for (int i = 0; i < sim->n; i++)
+        sim->mode[i] = CS_FREE;
+    /* assemble A = M - h D column by column from the operator */
+    double *A = calloc((size_t)n3 * n3, sizeof *A), *e = calloc((size_t)n3, sizeof *e),
+           *col = calloc((size_t)n3, sizeof *col), *rhs = calloc((size_t)n3, sizeof *rhs),
+           *v0 = calloc((size_t)n3, sizeof *v0), *v = calloc((size_t)n3, sizeof *v),
+           *ref = calloc((size_t)n3, sizeof *ref);
+    for (int c = 0; c < n3; c++) {
+        memset(e, 0, sizeof *e * (size_t)n3);
+        e[c] = 1;
+        cs_system_apply(sim, e, col);
+        for (int r = 0; r < n3; r++)
+            A[r * n3 + c] = col[r];
+    }
+    for (int r = 0; r < n3; r++) /* symmetric */
+        for (int c = 0; c < r; c++)
+            assert_true(fabs(A[r * n3 + c] - A[c * n3 + r]) < 1e-15);
+    unsigned seed = 17;
+    for (int k = 0; k < n3; k++) {
+        rhs[k] = 1e-6 * frand(&seed);
+        ref[k] = rhs[k];
+    }
+    int it = cs_cg_solve(sim, v0, rhs, v);
+    assert_true(it > 3); /* the damping couples particles: real work */
+    dense_solve(n3, A, ref);
+    double worst = 0, scale = 0;
+    for (int k = 0; k < n3; k++) {
+        worst = fmax(worst, fabs(v[k] - ref[k]));
+        scale = fmax(scale, fabs(ref[k]));
+    }
+    assert_true(worst < 1e-9 * scale);
+
+    /* with contact projection: normal velocities keep their start values and
+     * the tangential residual vanishes */
+    double N[3] = {0, 1, 0};
+    sim->contact_normal = calloc((size_t)n3, sizeof *sim->contact_normal);
+    for (int i = 0; i < sim->n; i += 3) {
+        sim->mode[i] = CS_CONTACT;
+        memcpy(sim->contact_normal + 3 * i, N, sizeof N);
+    }
+    sim->mode[1] = CS_FIXED;
+    for (int k = 0; k < n3; k++)
+        v0[k] = 0.1 * frand(&seed);
+    cs_cg_solve(sim, v0, rhs, v);
+    cs_system_apply(sim, v, col);
+    for (int i = 0; i < sim->n; i++) {
+        double r[3];
+        for (int d = 0; d < 3; d++)
+            r[d] = (rhs[3 * i + d] - col[3 * i + d]) / sim->mass[i];
+        if (sim->mode[i] == CS_FIXED) {
+            for (int d = 0; d < 3; d++)
+                assert_true(v[3 * i + d] == v0[3 * i + d]);
+        } else if (sim->mode[i] == CS_CONTACT) {
+            assert_true(fabs(v[3 * i + 1] - v0[3 * i + 1]) < 1e-15);
+            assert_true(fabs(r[0]) < 1e-11 && fabs(r[2]) < 1e-11);
+        } else {
+            assert_true(cs_norm(r) < 1e-11);
+        }
+    }
+    free(sim->contact_normal);
+    sim->contact_normal = NULL;
+    free(A), free(e), free(col), free(rhs), free(v0), free(v), free(ref);
+    cs_sim_destroy(sim);
+    cs_trimesh_destroy(mesh);
+}
+
+static void check_phi(const cs_body_def *b, double t, double x, double y, double z,
+                      double want_phi, const double *want_grad)
+{
+    double p[3] = {x, y, z}, g[3];
+    double phi = cs_body_def_phi(b, t, p, g);
+    assert_true(fabs(phi - want_phi) < 1e-12);
+    assert_true(fabs(cs_norm(g) - 1) < 1e-12);
+    if (want_grad)
+        for (int d = 0; d < 3; d++)
+            assert_true(fabs(g[d] - want_grad[d]) < 1e-9);
+    /* away from kinks the gradient is the finite difference of phi */
+    double eps = 1e-6, fd[3], gg[3];
+    for (int d = 0; d < 3; d++) {
+        double q[3] = {x, y, z};
+        q[d] += eps;
+        double a = cs_body_def_phi(b, t, q, gg);
+        q[d] -= 2 * eps;
+        fd[d] = (a - cs_body_def_phi(b, t, q, gg)) / (2 * eps);
+    }
+    if (want_grad)
+        for (int d = 0; d < 3; d++)
+            assert_true(fabs(fd[d] - g[d]) < 1e-6);
+}
+
+static void test_analytic_bodies(void **state)
+{
+    (void)state;
+    cs_body_def b = cs_default_body_def();
+    double up[3] = {0, 1, 0}, down[3] = {0, -1, 0}, px[3] = {1, 0, 0};
+    b.shape = CS_BODY_PLANE;
+    check_phi(&b, 0, 3, 0.25, -2, 0.25, up);
+    check_phi(&b, 0, 0, -0.5, 0, -0.5, up);
+
+    b.shape = CS_BODY_SPHERE;
+    b.radius = 2;
+    check_phi(&b, 0, 0, 3, 0, 1, up);
+    check_phi(&b, 0, 0, -0.5, 0, -1.5, down);
+    double diag[3] = {1 / sqrt(3.0), 1 / sqrt(3.0), 1 / sqrt(3.0)};
+    check_phi(&b, 0, 1, 1, 1, sqrt(3.0) - 2, diag);
+
+    b.shape = CS_BODY_BOX;
+    b.half_extents[0] = 1, b.half_extents[1] = 2, b.half_extents[2] = 3;
+    check_phi(&b, 0, 1.5, 0, 0, 0.5, px);             /* outside a face */
+    check_phi(&b, 0, 0, -1.5, 0.2, -0.5, down);       /* inside, nearest face */
+    double corner[3] = {1 / sqrt(2.0), 1 / sqrt(2.0), 0};
+    check_phi(&b, 0, 2, 3, 0, sqrt(2.0), corner);     /* outside an edge */
+
+    b.shape = CS_BODY_CYLINDER;
+    b.radius = 1, b.half_height = 2;
+    check_phi(&b, 0, 3, 0.5, 0, 2, px);               /* side */
+    check_phi(&b, 0, 0.2, 2.5, 0.1, 0.5, up);         /* cap */
+    check_phi(&b, 0, 0.5, 0, 0, -0.5, px);            /* inside, nearest the side */
+    double rim[3] = {0.6, 0.8, 0};
+    check_phi(&b, 0, 1.6, 2.8, 0, 1, rim);            /* beyond the rim */
+
+    /* a sphere moving and spinning: phi follows its centre, the velocity of
+     * a surface point is v + w x r */
+    b.shape = CS_BODY_SPHERE;
+    b.radius = 1;
+    b.motion.kind = CS_MOTION_CONSTANT;
+    b.motion.velocity[0] = 2;
+    b.motion.angular_velocity[1] = 3;
+    check_phi(&b, 0.5, 1, 2, 0, 1, up);               /* centre at (1, 0, 0) */
+    double vel[3], x[3] = {2, 0, 0};
+    cs_body_def_velocity(&b, 0.5, x, vel);
+    assert_true(fabs(vel[0] - 2) < 1e-12 && fabs(vel[1]) < 1e-12 && fabs(vel[2] + 3) < 1e-12);
+}
+
+static void test_gamma_regimes(void **state)
+{
+    (void)state;
+    double N[3] = {0, 1, 0}, still[3] = {0, 0, 0}, out[3];
+    /* separating: untouched */
+    double sep[3] = {1, 0.5, 0};
+    cs_gamma(sep, N, still, 0.5, out);
+    for (int d = 0; d < 3; d++)
+        assert_true(out[d] == sep[d]);
+    /* sliding: the normal part is removed, the tangential speed drops by
+     * mu times the normal speed removed */
+    double slide[3] = {2, -1, 0};
+    cs_gamma(slide, N, still, 0.5, out);
+    assert_true(fabs(out[0] - 1.5) < 1e-15 && out[1] == 0 && out[2] == 0);
+    /* sticking: friction enough to stop the tangential motion entirely */
+    double stick[3] = {0.3, -1, 0.4};
+    cs_gamma(stick, N, still, 0.6, out);
+    assert_true(out[0] == 0 && out[1] == 0 && out[2] == 0);
+    /* moving body: everything relative to it; the body may pull away (its
+     * normal velocity is the floor) */
+    double body[3] = {1, 0.2, 0}, v[3] = {1.5, -0.3, 0};
+    cs_gamma(v, N, body, 0.2, out);
+    assert_true(fabs(out[1] - 0.2) < 1e-15);
+    assert_true(fabs(out[0] - (1 + 0.5 - 0.2 * 0.5)) < 1e-15);
+    /* zero friction keeps the tangential velocity */
+    cs_gamma(slide, N, still, 0, out);
+    assert_true(out[0] == 2);
+}
+
+static void test_keyframe_motion(void **state)
+{
+    (void)state;
+    cs_keyframe keys[2] = {{0, {0, 0, 0}, {1, 0, 0, 0}}, {2, {2, 4, 0}, {0, 0, 0, 0}}};
+    double axis_q[4];
+    double w[3] = {0, 0, M_PI / 2}; /* 90 degrees about z over the span */
+    cs_quat_from_rotation_vector(w, 1, axis_q);
+    memcpy(keys[1].rotation, axis_q, sizeof axis_q);
+    cs_motion m = cs_motion_static();
+    m.kind = CS_MOTION_KEYFRAMES;
+    m.nkeys = 2;
+    m.keys = keys;
+    double R[9], c[3], v[3], om[3];
+    cs_motion_pose(&m, 1, R, c, v, om);
+    assert_true(fabs(c[0] - 1) < 1e-15 && fabs(c[1] - 2) < 1e-15);
+    assert_true(fabs(v[0] - 1) < 1e-15 && fabs(v[1] - 2) < 1e-15);
+    assert_true(fabs(om[2] - M_PI / 4) < 1e-12);
+    /* R at the middle is 45 degrees about z */
+    assert_true(fabs(R[0] - cos(M_PI / 4)) < 1e-12 && fabs(R[3] - sin(M_PI / 4)) < 1e-12);
+    /* held before the first and after the last key */
+    cs_motion_pose(&m, 5, R, c, v, om);
+    assert_true(c[0] == 2 && v[0] == 0 && om[2] == 0);
+    assert_true(fabs(R[1] + 1) < 1e-12);
+}
+
+static void test_plan_omits_absent_stages(void **state)
+{
+    (void)state;
+    cs_cloth_def cloth;
+    cs_trimesh *mesh;
+    cs_sim_def def = grid_def(&cloth, &mesh, 4, 19);
+    def.wind.drag = 1;              /* wind given but switched off */
+    def.wind_enabled = false;
+    cs_sim *sim = cs_sim_create(&def, NULL, 0);
+    assert_non_null(sim);
+    const cs_plan *plan = cs_sim_plan(sim);
+    assert_false(cs_plan_has(plan, CS_STAGE_BODY_COLLISION));
+    assert_false(cs_plan_has(plan, CS_STAGE_BODY_FRICTION));
+    assert_false(cs_plan_has(plan, CS_STAGE_WIND));
+    assert_false(cs_plan_has(plan, CS_STAGE_SCRIPTED_VERTICES));
+    assert_true(cs_plan_has(plan, CS_STAGE_VELOCITY_HALF));
+    assert_int_equal(cs_sim_advance_frame(sim, NULL), CS_OK);
+    const cs_stage_timing *t = cs_sim_stage_timing(sim);
+    cs_stage absent[] = {CS_STAGE_BODY_COLLISION, CS_STAGE_BODY_FRICTION, CS_STAGE_WIND,
+                         CS_STAGE_SCRIPTED_VERTICES};
+    for (size_t k = 0; k < sizeof absent / sizeof *absent; k++) {
+        assert_int_equal(t[absent[k]].calls, 0);
+        assert_true(t[absent[k]].seconds == 0);
+        assert_int_equal(cs_sim_stage_bytes(sim, absent[k]), 0);
+    }
+    assert_null(sim->contact_normal);
+    assert_null(sim->wind_normal);
+    assert_true(t[CS_STAGE_VELOCITY_HALF].calls > 0);
+    cs_sim_destroy(sim);
+
+    /* with a body, wind and a pin, all three appear and run */
+    cs_body_def body = cs_default_body_def();
+    int pinned = 0;
+    cs_vertex_script pin = {1, &pinned, cs_motion_static()};
+    cloth.nscripts = 1;
+    cloth.scripts = &pin;
+    def.nbodies = 1;
+    def.bodies = &body;
+    def.wind_enabled = true;
+    sim = cs_sim_create(&def, NULL, 0);
+    assert_non_null(sim);
+    plan = cs_sim_plan(sim);
+    assert_true(cs_plan_has(plan, CS_STAGE_BODY_COLLISION) && cs_plan_has(plan, CS_STAGE_WIND) &&
+                cs_plan_has(plan, CS_STAGE_SCRIPTED_VERTICES));
+    assert_int_equal(cs_sim_advance_frame(sim, NULL), CS_OK);
+    t = cs_sim_stage_timing(sim);
+    assert_true(t[CS_STAGE_BODY_COLLISION].calls > 0 && t[CS_STAGE_WIND].calls > 0);
+    assert_true(cs_sim_stage_bytes(sim, CS_STAGE_BODY_COLLISION) > 0);
+    /* the pinned vertex has not moved */
+    for (int d = 0; d < 3; d++)
+        assert_true(cs_sim_positions(sim)[d] == mesh->x[d]);
+    cs_sim_destroy(sim);
+    cs_trimesh_destroy(mesh);
+}
+
+/* A hanging cloth pinned at two corners stays stable at several resolutions
+ * with the automatic step; the step shrinks as the springs get shorter. */
+static void test_automatic_dt_is_stable_across_resolutions(void **state)
+{
+    (void)state;
+    double last_dt = INFINITY;
+    int resolutions[] = {4, 8, 16};
+    for (int r = 0; r < 3; r++) {
+        double size[2] = {1, 1}, q[4] = {1, 0, 0, 0}, c[3] = {0, 0, 0};
+        int res[2] = {resolutions[r], resolutions[r]};
+        cs_trimesh *mesh = cs_trimesh_create_grid(size, res, q, c);
+        int corners[2] = {0, resolutions[r]};
+        cs_vertex_script pin = {2, corners, cs_motion_static()};
+        cs_cloth_def cloth = {.name = "c", .mesh = mesh, .material = cs_default_cloth_material(),
+                              .nscripts = 1, .scripts = &pin};
+        cs_sim_def def = cs_default_sim_def();
+        def.ncloths = 1;
+        def.cloths = &cloth;
+        def.fps = 60;
+        cs_sim *sim = cs_sim_create(&def, NULL, 0);
+        assert_non_null(sim);
+        assert_true(cs_sim_dt(sim) < last_dt);
+        assert_true(cs_sim_dt(sim) <= 0.5 * cs_sim_stable_dt(sim) * (1 + 1e-12));
+        last_dt = cs_sim_dt(sim);
+        cs_frame_stats st;
+        for (int f = 0; f < 30; f++) {
+            assert_int_equal(cs_sim_advance_frame(sim, &st), CS_OK);
+            assert_true(st.max_speed < 10);
+        }
+        /* it fell, and hangs below the pins without flying apart */
+        const double *x = cs_sim_positions(sim);
+        double lowest = 0;
+        for (int i = 0; i < cs_sim_particle_count(sim); i++) {
+            assert_true(cs_norm(x + 3 * i) < 2.5);
+            lowest = fmin(lowest, x[3 * i + 1]);
+        }
+        assert_true(lowest < -0.3);
+        cs_sim_destroy(sim);
+        cs_trimesh_destroy(mesh);
+    }
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_spring_force_is_minus_energy_gradient),
+        cmocka_unit_test(test_damping_jacobian_matches_finite_differences),
+        cmocka_unit_test(test_cg_matches_dense_solve),
+        cmocka_unit_test(test_analytic_bodies),
+        cmocka_unit_test(test_gamma_regimes),
+        cmocka_unit_test(test_keyframe_motion),
+        cmocka_unit_test(test_plan_omits_absent_stages),
+        cmocka_unit_test(test_automatic_dt_is_stable_across_resolutions),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
