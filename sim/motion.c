@@ -17,7 +17,7 @@ void cs_quat_normalize(double q[4])
         q[i] /= n;
 }
 
-void cs_quat_mul(const double a[4], const double b[4], double out[4])
+void cs_quat_multiply(const double a[4], const double b[4], double out[4])
 {
     double r[4] = {
         a[0] * b[0] - a[1] * b[1] - a[2] * b[2] - a[3] * b[3],
@@ -78,11 +78,44 @@ void cs_quat_slerp(const double a[4], const double b_in[4], double s, double out
     /* a * exp(s * log(a^-1 b)): constant angular velocity between keys */
     double ainv[4] = {a[0], -a[1], -a[2], -a[3]};
     double rel[4], w[3], step[4];
-    cs_quat_mul(ainv, b_in, rel);
+    cs_quat_multiply(ainv, b_in, rel);
     cs_quat_to_rotation_vector(rel, w);
     cs_quat_from_rotation_vector(w, s, step);
-    cs_quat_mul(a, step, out);
+    cs_quat_multiply(a, step, out);
     cs_quat_normalize(out);
+}
+
+void cs_quat_from_euler_degrees(const double degrees[3], double out[4])
+{
+    double h[3];
+    for (int i = 0; i < 3; i++)
+        h[i] = degrees[i] * M_PI / 360.0; /* half angles in radians */
+    double qx[4] = {cos(h[0]), sin(h[0]), 0, 0};
+    double qy[4] = {cos(h[1]), 0, sin(h[1]), 0};
+    double qz[4] = {cos(h[2]), 0, 0, sin(h[2])};
+    double zy[4];
+    cs_quat_multiply(qz, qy, zy);
+    cs_quat_multiply(zy, qx, out);
+}
+
+void cs_quat_from_y_to(const double n[3], double out[4])
+{
+    double w = 1.0 + n[1];
+    if (w < 1e-12) { /* n = -y: half a turn about x */
+        out[0] = 0, out[1] = 1, out[2] = 0, out[3] = 0;
+        return;
+    }
+    double v[4] = {w, n[2], 0.0, -n[0]}; /* (1 + y.n, y x n) */
+    double len = sqrt(v[0] * v[0] + v[1] * v[1] + v[3] * v[3]);
+    for (int i = 0; i < 4; i++)
+        out[i] = v[i] / len;
+}
+
+void cs_quat_rotate(const double q[4], const double v[3], double out[3])
+{
+    double R[9];
+    cs_quat_to_matrix(q, R);
+    cs_mat_apply(R, v, out);
 }
 
 cs_motion cs_motion_static(void)
@@ -104,7 +137,7 @@ void cs_motion_pose(const cs_motion *m, double t, double R[9], double c[3],
     if (m->kind == CS_MOTION_CONSTANT) {
         double dq[4];
         cs_quat_from_rotation_vector(m->angular_velocity, t, dq);
-        cs_quat_mul(dq, m->rotation, q); /* world-axis rotation applied after R(0) */
+        cs_quat_multiply(dq, m->rotation, q); /* world-axis rotation applied after R(0) */
         for (int i = 0; i < 3; i++) {
             pos[i] += m->velocity[i] * t;
             vel[i] = m->velocity[i];
@@ -134,7 +167,7 @@ void cs_motion_pose(const cs_motion *m, double t, double R[9], double c[3],
             double q0inv[4] = {k[i].rotation[0], -k[i].rotation[1], -k[i].rotation[2],
                                -k[i].rotation[3]};
             double rel[4];
-            cs_quat_mul(k[i + 1].rotation, q0inv, rel);
+            cs_quat_multiply(k[i + 1].rotation, q0inv, rel);
             cs_quat_to_rotation_vector(rel, w);
             for (int d = 0; d < 3; d++)
                 w[d] /= span;

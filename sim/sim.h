@@ -78,6 +78,14 @@ typedef struct cs_motion {
     const cs_keyframe *keys;     /* sorted by time; copied by cs_sim_create */
 } cs_motion;
 
+/* Rotations as unit quaternions (w, x, y, z), shared with the importer. */
+void cs_quat_multiply(const double a[4], const double b[4], double out[4]);
+/* Degrees about world x, then y, then z: R = Rz Ry Rx. */
+void cs_quat_from_euler_degrees(const double degrees[3], double out[4]);
+/* The shortest-arc rotation taking +y onto the unit vector n. */
+void cs_quat_from_y_to(const double n[3], double out[4]);
+void cs_quat_rotate(const double q[4], const double v[3], double out[3]);
+
 /* The identity motion: static at the origin. */
 cs_motion cs_motion_static(void);
 

@@ -59,7 +59,6 @@ static inline void cs_mat_apply_transpose(const double R[9], const double a[3], 
 }
 
 void cs_quat_normalize(double q[4]);
-void cs_quat_mul(const double a[4], const double b[4], double out[4]);
 void cs_quat_to_matrix(const double q[4], double R[9]);
 /* Rotation by angle |w| * t about axis w (exponential map). */
 void cs_quat_from_rotation_vector(const double w[3], double t, double out[4]);
