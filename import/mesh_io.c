@@ -1,0 +1,519 @@
+/* mesh_io.c: triangle meshes to and from files through assimp's C API.
+ *
+ * Writing builds an aiScene by hand (one aiMesh per view, each in its own
+ * child node of one root node and named like the view; one empty material
+ * because several exporters index mMaterials; area-weighted normals) and
+ * hands it to aiExportScene. Assimp copies the scene before touching it, so
+ * the scene here is allocated and freed with malloc/free, never by assimp.
+ *
+ * Reading imports with triangulation and vertex joining and merges every
+ * mesh instance of the node tree, node transforms applied, into one
+ * cs_trimesh.
+ */
+#include "import/import.h"
+
+#include <assimp/cexport.h>
+#include <assimp/cimport.h>
+#include <assimp/postprocess.h>
+#include <assimp/scene.h>
+
+#include <errno.h>
+#include <math.h>
+#include <stdarg.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <strings.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+/* ------------------------------------------------------------- messages */
+
+static void set_err(char *err, size_t errlen, const char *fmt, ...)
+{
+    if (!err || errlen == 0)
+        return;
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(err, errlen, fmt, ap);
+    va_end(ap);
+}
+
+/* -------------------------------------------------------------- formats */
+
+typedef struct format_info {
+    const char *extension;
+    const char *assimp_id;   /* aiExportScene format id */
+} format_info;
+
+static const format_info FORMATS[] = {
+    [CS_MESH_PLY] = {"ply", "plyb"},      /* binary PLY */
+    [CS_MESH_OBJ] = {"obj", "objnomtl"},  /* OBJ without a .mtl file */
+    [CS_MESH_GLB] = {"glb", "glb2"},      /* glTF 2.0 binary */
+};
+#define NFORMATS ((int)(sizeof FORMATS / sizeof FORMATS[0]))
+
+bool cs_mesh_format_from_name(const char *name, cs_mesh_format *format)
+{
+    if (!name)
+        return false;
+    cs_mesh_format f;
+    if (strcasecmp(name, "ply") == 0)
+        f = CS_MESH_PLY;
+    else if (strcasecmp(name, "obj") == 0)
+        f = CS_MESH_OBJ;
+    else if (strcasecmp(name, "glb") == 0 || strcasecmp(name, "gltf") == 0)
+        f = CS_MESH_GLB;
+    else
+        return false;
+    if (format)
+        *format = f;
+    return true;
+}
+
+const char *cs_mesh_format_extension(cs_mesh_format format)
+{
+    if ((int)format < 0 || (int)format >= NFORMATS)
+        return NULL;
+    return FORMATS[format].extension;
+}
+
+/* --------------------------------------------------------------- writing */
+
+static void set_ai_string(struct aiString *s, const char *text)
+{
+    size_t n = text ? strlen(text) : 0;
+    if (n >= MAXLEN)
+        n = MAXLEN - 1;
+    if (n)
+        memcpy(s->data, text, n);
+    s->data[n] = '\0';
+    s->length = (ai_uint32)n;
+}
+
+static void set_identity(struct aiMatrix4x4 *m)
+{
+    memset(m, 0, sizeof *m);
+    m->a1 = m->b2 = m->c3 = m->d4 = 1;
+}
+
+static void free_mesh(struct aiMesh *mesh)
+{
+    if (!mesh)
+        return;
+    if (mesh->mFaces) {
+        for (unsigned f = 0; f < mesh->mNumFaces; f++)
+            free(mesh->mFaces[f].mIndices);
+        free(mesh->mFaces);
+    }
+    free(mesh->mVertices);
+    free(mesh->mNormals);
+    free(mesh);
+}
+
+/* Frees a scene built by build_scene (and only such a scene). */
+static void free_scene(struct aiScene *scene)
+{
+    if (!scene)
+        return;
+    if (scene->mMeshes) {
+        for (unsigned m = 0; m < scene->mNumMeshes; m++)
+            free_mesh(scene->mMeshes[m]);
+        free(scene->mMeshes);
+    }
+    if (scene->mMaterials) {
+        for (unsigned m = 0; m < scene->mNumMaterials; m++) {
+            if (scene->mMaterials[m]) {
+                free(scene->mMaterials[m]->mProperties);
+                free(scene->mMaterials[m]);
+            }
+        }
+        free(scene->mMaterials);
+    }
+    struct aiNode *root = scene->mRootNode;
+    if (root) {
+        if (root->mChildren) {
+            for (unsigned c = 0; c < root->mNumChildren; c++) {
+                if (root->mChildren[c])
+                    free(root->mChildren[c]->mMeshes);
+                free(root->mChildren[c]);
+            }
+            free(root->mChildren);
+        }
+        free(root);
+    }
+    free(scene);
+}
+
+/* Area-weighted vertex normals (renderers shade with them; without them the
+ * OBJ exporter writes a made-up one). A vertex of no area gets +y. */
+static void set_normals(const cs_mesh_view *view, struct aiVector3D *normals)
+{
+    double *n = calloc(3 * (size_t)view->nv, sizeof *n);
+    if (n) {
+        for (int t = 0; t < view->nt; t++) {
+            const int *tri = &view->tri[3 * t];
+            const double *a = &view->x[3 * tri[0]], *b = &view->x[3 * tri[1]],
+                         *c = &view->x[3 * tri[2]];
+            const double u[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]};
+            const double w[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};
+            const double cr[3] = {u[1] * w[2] - u[2] * w[1], u[2] * w[0] - u[0] * w[2],
+                                  u[0] * w[1] - u[1] * w[0]};
+            for (int k = 0; k < 3; k++)
+                for (int d = 0; d < 3; d++)
+                    n[3 * tri[k] + d] += cr[d];
+        }
+    }
+    for (int i = 0; i < view->nv; i++) {
+        double len = n ? sqrt(n[3 * i] * n[3 * i] + n[3 * i + 1] * n[3 * i + 1] +
+                              n[3 * i + 2] * n[3 * i + 2])
+                       : 0;
+        if (len > 0 && isfinite(len)) {
+            normals[i].x = (ai_real)(n[3 * i] / len);
+            normals[i].y = (ai_real)(n[3 * i + 1] / len);
+            normals[i].z = (ai_real)(n[3 * i + 2] / len);
+        } else {
+            normals[i].x = 0;
+            normals[i].y = 1;
+            normals[i].z = 0;
+        }
+    }
+    free(n);
+}
+
+static struct aiMesh *build_mesh(const cs_mesh_view *view, int index)
+{
+    struct aiMesh *mesh = calloc(1, sizeof *mesh);
+    if (!mesh)
+        return NULL;
+    mesh->mPrimitiveTypes = aiPrimitiveType_TRIANGLE;
+    mesh->mMaterialIndex = 0;
+    if (view->name && *view->name) {
+        set_ai_string(&mesh->mName, view->name);
+    } else {
+        char name[32];
+        snprintf(name, sizeof name, "mesh_%d", index);
+        set_ai_string(&mesh->mName, name);
+    }
+    mesh->mNumVertices = (unsigned)view->nv;
+    mesh->mVertices = malloc((size_t)view->nv * sizeof *mesh->mVertices);
+    mesh->mNormals = malloc((size_t)view->nv * sizeof *mesh->mNormals);
+    mesh->mFaces = calloc((size_t)view->nt, sizeof *mesh->mFaces);
+    if (!mesh->mVertices || !mesh->mNormals || !mesh->mFaces) {
+        free_mesh(mesh);
+        return NULL;
+    }
+    mesh->mNumFaces = (unsigned)view->nt;
+    for (int i = 0; i < view->nv; i++) {
+        mesh->mVertices[i].x = (ai_real)view->x[3 * i + 0];
+        mesh->mVertices[i].y = (ai_real)view->x[3 * i + 1];
+        mesh->mVertices[i].z = (ai_real)view->x[3 * i + 2];
+    }
+    set_normals(view, mesh->mNormals);
+    for (int t = 0; t < view->nt; t++) {
+        struct aiFace *face = &mesh->mFaces[t];
+        face->mIndices = malloc(3 * sizeof *face->mIndices);
+        if (!face->mIndices) {
+            free_mesh(mesh);
+            return NULL;
+        }
+        face->mNumIndices = 3;
+        for (int k = 0; k < 3; k++)
+            face->mIndices[k] = (unsigned)view->tri[3 * t + k];
+    }
+    return mesh;
+}
+
+/* An aiScene holding the views; NULL only when memory runs out. */
+static struct aiScene *build_scene(int nmeshes, const cs_mesh_view *meshes)
+{
+    struct aiScene *scene = calloc(1, sizeof *scene);
+    if (!scene)
+        return NULL;
+    /* mFlags stays 0: the exporters then treat the indexed meshes as they
+     * are instead of expanding and re-joining them, which keeps the vertex
+     * order of the file equal to the simulation's. */
+    scene->mMeshes = calloc((size_t)nmeshes, sizeof *scene->mMeshes);
+    scene->mMaterials = calloc(1, sizeof *scene->mMaterials);
+    scene->mRootNode = calloc(1, sizeof *scene->mRootNode);
+    if (!scene->mMeshes || !scene->mMaterials || !scene->mRootNode)
+        goto fail;
+
+    /* One material without properties: exporters look materials up by index. */
+    scene->mMaterials[0] = calloc(1, sizeof *scene->mMaterials[0]);
+    if (!scene->mMaterials[0])
+        goto fail;
+    scene->mNumMaterials = 1;
+
+    for (int m = 0; m < nmeshes; m++) {
+        scene->mMeshes[m] = build_mesh(&meshes[m], m);
+        if (!scene->mMeshes[m])
+            goto fail;
+        scene->mNumMeshes = (unsigned)m + 1;
+    }
+
+    /* A child node per mesh, named like it: glTF would otherwise fold all
+     * meshes of one node into a single mesh under the first name. */
+    struct aiNode *root = scene->mRootNode;
+    set_ai_string(&root->mName, "clothsim");
+    set_identity(&root->mTransformation);
+    root->mChildren = calloc((size_t)nmeshes, sizeof *root->mChildren);
+    if (!root->mChildren)
+        goto fail;
+    root->mNumChildren = (unsigned)nmeshes;
+    for (int m = 0; m < nmeshes; m++) {
+        struct aiNode *child = calloc(1, sizeof *child);
+        if (!child)
+            goto fail;
+        root->mChildren[m] = child;
+        child->mParent = root;
+        set_ai_string(&child->mName, scene->mMeshes[m]->mName.data);
+        set_identity(&child->mTransformation);
+        child->mMeshes = malloc(sizeof *child->mMeshes);
+        if (!child->mMeshes)
+            goto fail;
+        child->mMeshes[0] = (unsigned)m;
+        child->mNumMeshes = 1;
+    }
+    return scene;
+
+fail:
+    free_scene(scene);
+    return NULL;
+}
+
+/* Everything cs_mesh_write can check before assimp sees the data. */
+static bool check_views(const char *path, int nmeshes, const cs_mesh_view *meshes,
+                        char *err, size_t errlen)
+{
+    if (nmeshes <= 0 || !meshes) {
+        set_err(err, errlen, "%s: no meshes to write", path);
+        return false;
+    }
+    for (int m = 0; m < nmeshes; m++) {
+        const cs_mesh_view *v = &meshes[m];
+        const char *name = v->name ? v->name : "(unnamed)";
+        if (v->nv <= 0 || v->nt <= 0 || !v->x || !v->tri) {
+            set_err(err, errlen, "%s: mesh %d '%s' has no vertices or no triangles", path, m, name);
+            return false;
+        }
+        for (int i = 0; i < 3 * v->nt; i++) {
+            if (v->tri[i] < 0 || v->tri[i] >= v->nv) {
+                set_err(err, errlen, "%s: mesh %d '%s': triangle %d refers to vertex %d of %d",
+                        path, m, name, i / 3, v->tri[i], v->nv);
+                return false;
+            }
+        }
+    }
+    return true;
+}
+
+int cs_mesh_write(const char *path, cs_mesh_format format, int nmeshes,
+                  const cs_mesh_view *meshes, char *err, size_t errlen)
+{
+    if (!path || !*path) {
+        set_err(err, errlen, "cs_mesh_write: no file name given");
+        return CS_IMPORT_BAD_INPUT;
+    }
+    if ((int)format < 0 || (int)format >= NFORMATS) {
+        set_err(err, errlen, "%s: unknown mesh format %d", path, (int)format);
+        return CS_IMPORT_BAD_INPUT;
+    }
+    if (!check_views(path, nmeshes, meshes, err, errlen))
+        return CS_IMPORT_BAD_INPUT;
+
+    size_t len = strlen(path);
+    char *tmp = malloc(len + 5);
+    if (!tmp) {
+        set_err(err, errlen, "%s: out of memory", path);
+        return CS_IMPORT_NOMEM;
+    }
+    memcpy(tmp, path, len);
+    memcpy(tmp + len, ".tmp", 5);
+
+    /* Open the file ourselves first: assimp's C API loses the exporter's
+     * message, while errno says exactly why a path cannot be written. */
+    FILE *probe = fopen(tmp, "wb");
+    if (!probe) {
+        set_err(err, errlen, "cannot write %s: %s", path, strerror(errno));
+        free(tmp);
+        return CS_IMPORT_BAD_INPUT;
+    }
+    fclose(probe);
+
+    struct aiScene *scene = build_scene(nmeshes, meshes);
+    if (!scene) {
+        remove(tmp);
+        free(tmp);
+        set_err(err, errlen, "%s: out of memory", path);
+        return CS_IMPORT_NOMEM;
+    }
+    enum aiReturn r = aiExportScene(scene, FORMATS[format].assimp_id, tmp, 0);
+    free_scene(scene);
+
+    int status = CS_IMPORT_OK;
+    struct stat st;
+    if (r != aiReturn_SUCCESS) {
+        set_err(err, errlen, "cannot write %s: assimp's '%s' exporter failed",
+                path, FORMATS[format].assimp_id);
+        status = CS_IMPORT_BAD_INPUT;
+    } else if (stat(tmp, &st) != 0 || st.st_size == 0) {
+        set_err(err, errlen, "cannot write %s: assimp's '%s' exporter wrote nothing",
+                path, FORMATS[format].assimp_id);
+        status = CS_IMPORT_BAD_INPUT;
+    } else if (rename(tmp, path) != 0) {
+        set_err(err, errlen, "cannot write %s: rename from %s failed: %s",
+                path, tmp, strerror(errno));
+        status = CS_IMPORT_BAD_INPUT;
+    }
+    if (status != CS_IMPORT_OK)
+        remove(tmp);
+    free(tmp);
+    return status;
+}
+
+/* --------------------------------------------------------------- reading */
+
+typedef struct merge_state {
+    const struct aiScene *scene;
+    cs_trimesh *out;     /* NULL while counting */
+    long nv, nt;         /* counts so far */
+    int depth_error;
+} merge_state;
+
+/* c = a * b for assimp's row-major 4x4 (translation in a4, b4, c4). */
+static void mat_mul(const double a[16], const double b[16], double c[16])
+{
+    for (int i = 0; i < 4; i++)
+        for (int j = 0; j < 4; j++) {
+            double s = 0;
+            for (int k = 0; k < 4; k++)
+                s += a[4 * i + k] * b[4 * k + j];
+            c[4 * i + j] = s;
+        }
+}
+
+static void mat_from_ai(const struct aiMatrix4x4 *m, double out[16])
+{
+    const double v[16] = {m->a1, m->a2, m->a3, m->a4, m->b1, m->b2, m->b3, m->b4,
+                          m->c1, m->c2, m->c3, m->c4, m->d1, m->d2, m->d3, m->d4};
+    memcpy(out, v, sizeof v);
+}
+
+static int mesh_triangles(const struct aiMesh *mesh)
+{
+    int n = 0;
+    for (unsigned f = 0; f < mesh->mNumFaces; f++)
+        if (mesh->mFaces[f].mNumIndices == 3)
+            n++;
+    return n;
+}
+
+/* Walks the node tree; counts when st->out is NULL, else fills. */
+static void merge_node(merge_state *st, const struct aiNode *node, const double parent[16], int depth)
+{
+    if (depth > 256) {
+        st->depth_error = 1;
+        return;
+    }
+    double local[16], world[16];
+    mat_from_ai(&node->mTransformation, local);
+    mat_mul(parent, local, world);
+
+    for (unsigned i = 0; i < node->mNumMeshes; i++) {
+        if (node->mMeshes[i] >= st->scene->mNumMeshes)
+            continue;
+        const struct aiMesh *mesh = st->scene->mMeshes[node->mMeshes[i]];
+        int ntri = mesh_triangles(mesh);
+        if (ntri == 0 || !mesh->mVertices)
+            continue;   /* points and lines carry no cloth or body surface */
+        if (st->out) {
+            long base = st->nv;
+            for (unsigned v = 0; v < mesh->mNumVertices; v++) {
+                const double p[3] = {mesh->mVertices[v].x, mesh->mVertices[v].y,
+                                     mesh->mVertices[v].z};
+                double *x = &st->out->x[3 * (base + v)];
+                for (int r = 0; r < 3; r++)
+                    x[r] = world[4 * r + 0] * p[0] + world[4 * r + 1] * p[1] +
+                           world[4 * r + 2] * p[2] + world[4 * r + 3];
+            }
+            for (unsigned f = 0; f < mesh->mNumFaces; f++) {
+                const struct aiFace *face = &mesh->mFaces[f];
+                if (face->mNumIndices != 3)
+                    continue;
+                for (int k = 0; k < 3; k++)
+                    st->out->tri[3 * st->nt + k] = (int)(base + face->mIndices[k]);
+                st->nt++;
+            }
+        } else {
+            st->nt += ntri;
+        }
+        st->nv += mesh->mNumVertices;
+    }
+    for (unsigned c = 0; c < node->mNumChildren; c++)
+        merge_node(st, node->mChildren[c], world, depth + 1);
+}
+
+cs_trimesh *cs_mesh_read(const char *path, char *err, size_t errlen)
+{
+    if (!path || !*path) {
+        set_err(err, errlen, "cs_mesh_read: no file name given");
+        return NULL;
+    }
+    /* assimp only says "Unable to open file": ask the system why first. */
+    if (access(path, R_OK) != 0) {
+        set_err(err, errlen, "cannot read mesh %s: %s", path, strerror(errno));
+        return NULL;
+    }
+    const struct aiScene *scene =
+        aiImportFile(path, aiProcess_Triangulate | aiProcess_JoinIdenticalVertices);
+    if (!scene) {
+        set_err(err, errlen, "cannot read mesh %s: %s", path, aiGetErrorString());
+        return NULL;
+    }
+    if (!scene->mRootNode) {
+        set_err(err, errlen, "cannot read mesh %s: the file has no scene nodes", path);
+        aiReleaseImport(scene);
+        return NULL;
+    }
+
+    static const double identity[16] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
+    merge_state st = {.scene = scene};
+    merge_node(&st, scene->mRootNode, identity, 0);
+    if (st.depth_error) {
+        set_err(err, errlen, "cannot read mesh %s: node tree deeper than 256 levels", path);
+        aiReleaseImport(scene);
+        return NULL;
+    }
+    if (st.nt == 0) {
+        set_err(err, errlen, "%s: the file holds no triangles", path);
+        aiReleaseImport(scene);
+        return NULL;
+    }
+    if (st.nv > INT32_MAX / 3 || st.nt > INT32_MAX / 3) {
+        set_err(err, errlen, "%s: too large (%ld vertices, %ld triangles)", path, st.nv, st.nt);
+        aiReleaseImport(scene);
+        return NULL;
+    }
+
+    cs_trimesh *mesh = cs_trimesh_create((int)st.nv, (int)st.nt);
+    if (!mesh) {
+        set_err(err, errlen, "%s: out of memory for %ld vertices", path, st.nv);
+        aiReleaseImport(scene);
+        return NULL;
+    }
+    st.out = mesh;
+    st.nv = st.nt = 0;
+    merge_node(&st, scene->mRootNode, identity, 0);
+    aiReleaseImport(scene);
+
+    for (int i = 0; i < 3 * mesh->nv; i++) {
+        if (!isfinite(mesh->x[i])) {
+            set_err(err, errlen, "%s: vertex %d has a non-finite coordinate", path, i / 3);
+            cs_trimesh_destroy(mesh);
+            return NULL;
+        }
+    }
+    return mesh;
+}
