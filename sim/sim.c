@@ -213,13 +213,11 @@ cs_sim *cs_sim_create(const cs_sim_def *def, char *err, size_t errlen)
             memcpy(sim->v + 3 * (offset + i), cl->velocity, 3 * sizeof(double));
             sim->is_free[offset + i] = 1;
         }
-        if (cs_springs_add_mesh(&sim->springs, offset, m->nv, m->nt, m->tri, sim->x + 3 * offset,
-                                sim->mass, cl->material.edge_stiffness,
-                                cl->material.edge_overdamping, cl->material.bend_stiffness,
-                                cl->material.bend_overdamping))
+        /* springs hold global particle indices into x and mass */
+        if (cs_springs_add_mesh(&sim->springs, offset, m->nv, m->nt, m->tri, sim->x, sim->mass,
+                                cl->material.edge_stiffness, cl->material.edge_overdamping,
+                                cl->material.bend_stiffness, cl->material.bend_overdamping))
             goto nomem;
-        /* springs_add_mesh indexes mass globally: it was given sim->mass and
-         * global ends, positions offset to this cloth */
         sim->nscripts += cl->nscripts;
         offset += m->nv;
     }

@@ -24,7 +24,8 @@ typedef struct cs_springs {
 } cs_springs;
 
 /* Appends the edge and bending springs of a triangle mesh whose vertices are
- * particles [offset, offset + nv). Stiffness, overdamping fractions and
+ * particles [offset, offset + nv) of the global arrays x and mass (triangle
+ * indices are local to the mesh). Stiffness, overdamping fractions and
  * masses give E and d (d = xi * 2 sqrt(E m_reduced / L0)). Returns 0 or -1
  * on allocation failure. */
 int cs_springs_add_mesh(cs_springs *s, int offset, int nv, int nt, const int *tri,

@@ -462,6 +462,174 @@ static void test_automatic_dt_is_stable_across_resolutions(void **state)
     }
 }
 
+
+/* Linear normal drag (Section 8): a horizontal sheet of areal density rho
+ * falling in still air feels -c A (v.n) n per vertex and m = rho A, so every
+ * vertex follows v(t) = v_t (1 - exp(-c t / rho)), v_t = rho g / c, exactly. */
+static void test_wind_drag_terminal_velocity(void **state)
+{
+    (void)state;
+    double size[2] = {1, 1}, q[4] = {1, 0, 0, 0}, c[3] = {0, 0, 0};
+    int res[2] = {6, 6};
+    cs_trimesh *mesh = cs_trimesh_create_grid(size, res, q, c);
+    cs_cloth_def cloth = {.name = "sheet", .mesh = mesh, .material = cs_default_cloth_material()};
+    cloth.material.density = 0.1;
+    cs_sim_def def = cs_default_sim_def();
+    def.ncloths = 1;
+    def.cloths = &cloth;
+    def.fps = 100;
+    def.wind_enabled = true;
+    def.wind.drag = 1.0;
+    def.cg_tolerance = 1e-10;
+    cs_sim *sim = cs_sim_create(&def, NULL, 0);
+    assert_non_null(sim);
+    double rho = 0.1, cd = 1.0, vt = rho * 9.8 / cd;
+    for (int f = 1; f <= 50; f++) {
+        assert_int_equal(cs_sim_advance_frame(sim, NULL), CS_OK);
+        double t = cs_sim_time(sim), exact = -vt * (1 - exp(-cd * t / rho));
+        for (int i = 0; i < cs_sim_particle_count(sim); i++) {
+            const double *v = cs_sim_velocities(sim) + 3 * i;
+            assert_true(fabs(v[1] - exact) < 1e-4 * vt);
+            assert_true(fabs(v[0]) < 1e-9 && fabs(v[2]) < 1e-9);
+        }
+    }
+    cs_sim_destroy(sim);
+    cs_trimesh_destroy(mesh);
+}
+
+/* Friction from a moving body: a particle at rest on a plane sliding along
+ * x at 1 m/s is dragged at mu g until it moves with the plane, then rides
+ * along (static friction). */
+static void test_moving_body_drags_particle(void **state)
+{
+    (void)state;
+    cs_trimesh *mesh = cs_trimesh_create(1, 0);
+    cs_cloth_def cloth = {.name = "p", .mesh = mesh, .material = cs_default_cloth_material()};
+    cs_body_def belt = cs_default_body_def();
+    belt.friction = 0.5;
+    belt.motion.kind = CS_MOTION_CONSTANT;
+    belt.motion.velocity[0] = 1.0;
+    cs_sim_def def = cs_default_sim_def();
+    def.ncloths = 1;
+    def.cloths = &cloth;
+    def.nbodies = 1;
+    def.bodies = &belt;
+    def.fps = 100;
+    def.dt = 1e-3;
+    cs_sim *sim = cs_sim_create(&def, NULL, 0);
+    assert_non_null(sim);
+    double a = 0.5 * 9.8, t_match = 1.0 / a;
+    for (int f = 1; f <= 50; f++) {
+        assert_int_equal(cs_sim_advance_frame(sim, NULL), CS_OK);
+        double t = cs_sim_time(sim);
+        double x = t < t_match ? 0.5 * a * t * t : 0.5 * a * t_match * t_match + (t - t_match);
+        double v = t < t_match ? a * t : 1.0;
+        const double *px = cs_sim_positions(sim), *pv = cs_sim_velocities(sim);
+        assert_true(fabs(px[0] - x) < 1e-3 * 1e-1 + 1e-6);
+        assert_true(fabs(pv[0] - v) < 1e-9 + (fabs(t - t_match) < 2e-3 ? a * 1e-3 : 0));
+        assert_true(fabs(px[1]) < 1e-12); /* stays on the belt */
+    }
+    cs_sim_destroy(sim);
+    cs_trimesh_destroy(mesh);
+}
+
+/* Keyframed vertices land exactly on their path; free ones follow. */
+static void test_scripted_vertices_follow_keys(void **state)
+{
+    (void)state;
+    double size[2] = {1, 1}, q[4] = {1, 0, 0, 0}, c[3] = {0, 0, 0};
+    int res[2] = {4, 4};
+    cs_trimesh *mesh = cs_trimesh_create_grid(size, res, q, c);
+    int moved[2] = {0, 4};
+    cs_keyframe keys[2] = {{0, {0, 0, -0.5}, {1, 0, 0, 0}}, {1, {0, 2, -0.5}, {1, 0, 0, 0}}};
+    cs_vertex_script script = {2, moved, cs_motion_static()};
+    script.motion.kind = CS_MOTION_KEYFRAMES;
+    script.motion.position[2] = -0.5;
+    script.motion.nkeys = 2;
+    script.motion.keys = keys;
+    cs_cloth_def cloth = {.name = "c", .mesh = mesh, .material = cs_default_cloth_material(),
+                          .nscripts = 1, .scripts = &script};
+    cloth.material.density = 0.1;
+    cs_sim_def def = cs_default_sim_def();
+    def.ncloths = 1;
+    def.cloths = &cloth;
+    def.fps = 10;
+    cs_sim *sim = cs_sim_create(&def, NULL, 0);
+    assert_non_null(sim);
+    for (int f = 1; f <= 10; f++) {
+        assert_int_equal(cs_sim_advance_frame(sim, NULL), CS_OK);
+        double t = cs_sim_time(sim);
+        for (int k = 0; k < 2; k++) {
+            const double *x = cs_sim_positions(sim) + 3 * moved[k];
+            const double *v = cs_sim_velocities(sim) + 3 * moved[k];
+            assert_true(fabs(x[1] - 2 * t) < 1e-12);
+            assert_true(fabs(x[0] - mesh->x[3 * moved[k]]) < 1e-12);
+            assert_true(fabs(v[1] - 2) < 1e-12);
+        }
+    }
+    /* the cloth was lifted with its pinned edge, and hangs below it */
+    const double *x = cs_sim_positions(sim);
+    double centre_y = x[3 * 12 + 1];
+    assert_true(centre_y > 0.8 && centre_y < 2.0);
+    cs_sim_destroy(sim);
+    cs_trimesh_destroy(mesh);
+}
+
+/* Several cloths in one simulation behave as each would alone: particle
+ * indices, springs and masses of the second cloth are offset correctly. */
+static void test_two_cloths_match_each_alone(void **state)
+{
+    (void)state;
+    double size_a[2] = {1, 1}, size_b[2] = {0.7, 1.3}, q[4] = {1, 0, 0, 0};
+    double ca[3] = {0, 0, 0}, cb[3] = {3, 1, 0};
+    int ra[2] = {5, 4}, rb[2] = {3, 6};
+    cs_trimesh *ma = cs_trimesh_create_grid(size_a, ra, q, ca);
+    cs_trimesh *mb = cs_trimesh_create_grid(size_b, rb, q, cb);
+    int pin_a = 0, pin_b = 2;
+    cs_vertex_script sa = {1, &pin_a, cs_motion_static()}, sb = {1, &pin_b, cs_motion_static()};
+    cs_cloth_def cloths[2] = {
+        {.name = "a", .mesh = ma, .material = cs_default_cloth_material(), .nscripts = 1, .scripts = &sa},
+        {.name = "b", .mesh = mb, .material = cs_default_cloth_material(), .nscripts = 1, .scripts = &sb},
+    };
+    cloths[0].material.density = 0.1;
+    cloths[1].material.density = 0.2;
+    cloths[1].material.edge_stiffness = 20;
+    cs_sim_def def = cs_default_sim_def();
+    def.cloths = cloths;
+    def.cg_tolerance = 1e-13;
+    def.fps = 30;
+    def.dt = 1e-4;
+    def.ncloths = 2;
+    cs_sim *both = cs_sim_create(&def, NULL, 0);
+    def.ncloths = 1;
+    cs_sim *alone_a = cs_sim_create(&def, NULL, 0);
+    def.cloths = cloths + 1;
+    cs_sim *alone_b = cs_sim_create(&def, NULL, 0);
+    assert_non_null(both);
+    assert_non_null(alone_a);
+    assert_non_null(alone_b);
+    assert_int_equal(cs_sim_cloth_offset(both, 1), ma->nv);
+    for (int f = 0; f < 6; f++) {
+        assert_int_equal(cs_sim_advance_frame(both, NULL), CS_OK);
+        assert_int_equal(cs_sim_advance_frame(alone_a, NULL), CS_OK);
+        assert_int_equal(cs_sim_advance_frame(alone_b, NULL), CS_OK);
+    }
+    const double *x = cs_sim_positions(both);
+    double moved = 0;
+    for (int k = 0; k < 3 * ma->nv; k++)
+        assert_true(fabs(x[k] - cs_sim_positions(alone_a)[k]) < 1e-9);
+    for (int k = 0; k < 3 * mb->nv; k++) {
+        assert_true(fabs(x[3 * ma->nv + k] - cs_sim_positions(alone_b)[k]) < 1e-9);
+        moved = fmax(moved, fabs(x[3 * ma->nv + k] - mb->x[k]));
+    }
+    assert_true(moved > 0.05);
+    cs_sim_destroy(both);
+    cs_sim_destroy(alone_a);
+    cs_sim_destroy(alone_b);
+    cs_trimesh_destroy(ma);
+    cs_trimesh_destroy(mb);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -473,6 +641,10 @@ int main(void)
         cmocka_unit_test(test_keyframe_motion),
         cmocka_unit_test(test_plan_omits_absent_stages),
         cmocka_unit_test(test_automatic_dt_is_stable_across_resolutions),
+        cmocka_unit_test(test_wind_drag_terminal_velocity),
+        cmocka_unit_test(test_moving_body_drags_particle),
+        cmocka_unit_test(test_scripted_vertices_follow_keys),
+        cmocka_unit_test(test_two_cloths_match_each_alone),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
