@@ -483,7 +483,7 @@ static int inum(loader *L, const int *v, int def, int lo, const char *path, int 
 static int vec(loader *L, const double *v, int n, const double *def, range r, const char *path,
                double *out)
 {
-    char p[PATH_LEN];
+    char p[PATH_LEN + 16]; /* room for "[i]" after a full path */
     for (int i = 0; i < n; i++) {
         if (v && !in_range(v[i], r)) {
             snprintf(p, sizeof p, "%s[%d]", path, i);

@@ -1,5 +1,5 @@
 /* scene_schema.c: the libcyaml schema of a scene file and queries on it.
- * docs/scene-reference.md describes the same keys for users; keep the two
+ * README.md (Scene file reference) describes the same keys for users; keep the two
  * in step. */
 #include "import/scene_schema.h"
 

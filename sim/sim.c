@@ -75,6 +75,9 @@ static int validate(const cs_sim_def *def, char *err, size_t errlen)
 {
     if (def->ncloths < 1)
         return fail(err, errlen, "a scene needs at least one cloth");
+    if (def->self_collision) /* never a silent wrong result: refuse, do not ignore */
+        return fail(err, errlen, "self-collision (Sections 4 and 5) is not available in this "
+                                 "version; set effects.self_collision to false");
     if (!(def->fps > 0))
         return fail(err, errlen, "fps must be > 0");
     if (!(def->dt >= 0) || !(def->dt_safety > 0 && def->dt_safety <= 1))

@@ -74,6 +74,11 @@ err_has '--set'
 run 2 run tiny.yaml --plan --set time.frames=two
 [ ! -e out ] || fail "an invalid scene wrote output"
 
+# --- an effect this version cannot simulate is refused, not ignored
+run 2 run tiny.yaml --set effects.self_collision=true
+err_has 'self-collision'
+[ ! -e out ] || fail "a refused scene wrote output"
+
 # --- output that cannot be written: status 4, the message names the path
 : >not_a_dir
 run 4 run tiny.yaml -q -o not_a_dir/sub

@@ -1,0 +1,8 @@
+#!/bin/sh
+# Remakes the gallery from the scenes and benchmarks (Release build).
+set -eu
+cd "$(dirname "$0")/.."
+scripts/install-deps.sh
+cmake -S . -B build -DCMAKE_BUILD_TYPE=Release >/dev/null
+cmake --build build -j"$(nproc)"
+build/bench_accuracy_time gallery
