@@ -1116,6 +1116,26 @@ static int convert_scene(loader *L, const cs_raw_scene *r, const char *default_n
         if (r->effects->friction)
             s->def.friction_method = (cs_friction_method)*r->effects->friction;
     }
+    if (r->self_collision) {
+        const cs_raw_self *c = r->self_collision;
+        cs_self_collision_def *d = &s->def.self;
+        static const range epsilon = {GE, -1, GE, 1};
+        if ((rc = num(L, c->thickness, d->thickness, POSITIVE, "self_collision.thickness",
+                      &d->thickness)) ||
+            (rc = num(L, c->stiffness, d->stiffness, NONNEG, "self_collision.stiffness",
+                      &d->stiffness)) ||
+            (rc = num(L, c->friction, d->friction, NONNEG, "self_collision.friction",
+                      &d->friction)) ||
+            (rc = num(L, c->edge_flip_epsilon, d->edge_flip_epsilon, epsilon,
+                      "self_collision.edge_flip_epsilon", &d->edge_flip_epsilon)) ||
+            (rc = inum(L, c->zone_iterations, d->zone_iterations, 1,
+                       "self_collision.zone_iterations", &d->zone_iterations)))
+            goto fail;
+        if (c->scheme)
+            d->scheme = (cs_collision_scheme)*c->scheme;
+        if (c->verify)
+            d->verify = *c->verify;
+    }
     memset(&s->def.wind, 0, sizeof s->def.wind);
     if (r->wind) {
         if ((rc = vec(L, r->wind->velocity, 3, zero3, ANY, "wind.velocity",

@@ -74,6 +74,23 @@ static const cyaml_schema_field_t effects_fields[] = {
     CYAML_FIELD_END,
 };
 
+static const cyaml_strval_t scheme_names[] = {
+    {"fixed", CS_COLLISION_FIXED},
+    {"rewind", CS_COLLISION_REWIND},
+};
+
+static const cyaml_schema_field_t self_fields[] = {
+    NUM("thickness", cs_raw_self, thickness),
+    NUM("stiffness", cs_raw_self, stiffness),
+    NUM("friction", cs_raw_self, friction),
+    NUM("edge_flip_epsilon", cs_raw_self, edge_flip_epsilon),
+    INT("zone_iterations", cs_raw_self, zone_iterations),
+    CYAML_FIELD_ENUM_PTR("scheme", OPT | CYAML_FLAG_STRICT, cs_raw_self, scheme, scheme_names,
+                         CYAML_ARRAY_LEN(scheme_names)),
+    BOOL("verify", cs_raw_self, verify),
+    CYAML_FIELD_END,
+};
+
 static const cyaml_schema_field_t wind_fields[] = {
     VEC("velocity", OPT, cs_raw_wind, velocity, 3),
     NUM("drag", cs_raw_wind, drag),
@@ -208,6 +225,7 @@ static const cyaml_schema_field_t scene_fields[] = {
     CYAML_FIELD_MAPPING_PTR("time", OPT, cs_raw_scene, time, time_fields),
     VEC("gravity", OPT, cs_raw_scene, gravity, 3),
     CYAML_FIELD_MAPPING_PTR("effects", OPT, cs_raw_scene, effects, effects_fields),
+    CYAML_FIELD_MAPPING_PTR("self_collision", OPT, cs_raw_scene, self_collision, self_fields),
     CYAML_FIELD_MAPPING_PTR("wind", OPT, cs_raw_scene, wind, wind_fields),
     CYAML_FIELD_MAPPING_PTR("output", OPT, cs_raw_scene, output, output_fields),
     CYAML_FIELD_MAPPING_PTR("camera", OPT, cs_raw_scene, camera, camera_fields),

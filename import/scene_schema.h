@@ -30,6 +30,16 @@ typedef struct cs_raw_effects {
     int *friction;             /* cs_friction_method */
 } cs_raw_effects;
 
+typedef struct cs_raw_self {
+    double *thickness;
+    double *stiffness;
+    double *friction;
+    double *edge_flip_epsilon;
+    int *zone_iterations;
+    int *scheme;               /* cs_collision_scheme */
+    bool *verify;
+} cs_raw_self;
+
 typedef struct cs_raw_wind {
     double *velocity;          /* 3 */
     double *drag;
@@ -136,6 +146,7 @@ typedef struct cs_raw_scene {
     cs_raw_time *time;
     double *gravity;           /* 3 */
     cs_raw_effects *effects;
+    cs_raw_self *self_collision;
     cs_raw_wind *wind;
     cs_raw_output *output;
     cs_raw_camera *camera;

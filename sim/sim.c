@@ -24,6 +24,20 @@ cs_cloth_material cs_default_cloth_material(void)
     return m;
 }
 
+cs_self_collision_def cs_default_self_collision_def(void)
+{
+    cs_self_collision_def d = {
+        .thickness = 0.01,
+        .stiffness = 30,
+        .friction = 0.3,
+        .edge_flip_epsilon = 0.5,
+        .zone_iterations = 8,
+        .scheme = CS_COLLISION_FIXED,
+        .verify = false,
+    };
+    return d;
+}
+
 cs_sim_def cs_default_sim_def(void)
 {
     cs_sim_def d;
@@ -38,6 +52,7 @@ cs_sim_def cs_default_sim_def(void)
     d.friction_method = CS_FRICTION_IMPROVED;
     d.bodies_enabled = true;
     d.wind_enabled = false;
+    d.self = cs_default_self_collision_def();
     return d;
 }
 

@@ -179,6 +179,28 @@ typedef struct cs_wind_def {
     double drag;
 } cs_wind_def;
 
+/* Self-collision (Sections 4 and 5). Defaults from Table 1. */
+typedef enum cs_collision_scheme {
+    CS_COLLISION_FIXED = 0,   /* the paper: fixed k_i, never rewind */
+    CS_COLLISION_REWIND,      /* Bridson et al. 2002: on a collision in step C,
+                                 rewind and retry with k_i halved, down to 1 */
+} cs_collision_scheme;
+
+typedef struct cs_self_collision_def {
+    double thickness;          /* h, repulsion thickness, m          (0.01) */
+    double stiffness;          /* k of Eq. 1, repulsion spring constant (30) */
+    double friction;           /* cloth-cloth Coulomb coefficient       (0.3) */
+    double edge_flip_epsilon;  /* history rule for edge/edge: flip when
+                                  s0 . s < epsilon (0 aggressive, 0.9
+                                  conservative)                         (0.5) */
+    int zone_iterations;       /* step C passes before impact zones      (8) */
+    cs_collision_scheme scheme;
+    bool verify;               /* count intersecting triangle pairs at each
+                                  frame end (an independent check)  (false) */
+} cs_self_collision_def;
+
+cs_self_collision_def cs_default_self_collision_def(void);
+
 typedef struct cs_sim_def {
     double gravity[3];
     double fps;                /* frames per second of output */
@@ -190,7 +212,8 @@ typedef struct cs_sim_def {
     cs_friction_method friction_method;
     bool bodies_enabled;       /* effects: body collisions and friction */
     bool wind_enabled;         /* effects: wind drag */
-    bool self_collision;       /* effects: repulsions and collisions (issue 3) */
+    bool self_collision;       /* effects: repulsions and collisions */
+    cs_self_collision_def self;
     cs_wind_def wind;
     int ncloths;
     const cs_cloth_def *cloths;
