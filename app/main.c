@@ -3,6 +3,9 @@
  * Only dispatch lives here; each command has its own file (run.c).
  */
 #include "app/run.h"
+#include "app/mesh_cmds.h"
+#include "app/render_cmd.h"
+#include "app/intersections_cmd.h"
 
 #include <stdio.h>
 #include <string.h>
@@ -17,6 +20,10 @@ static void usage(FILE *out)
           "\n"
           "commands:\n"
           "  run SCENE        simulate a scene file and write a mesh file per frame\n"
+          "  render TARGET    render a run's frames (or a scene's start) to PNG images\n"
+          "  intersections MESHFILE  count intersecting triangle pairs (exact)\n"
+          "  mesh-info FILE   what import sees in a mesh file\n"
+          "  levelset FILE -o OUT.vdb  convert a mesh to a signed distance grid (OpenVDB)\n"
           "  help [COMMAND]   show help, for a command if one is named\n"
           "\n"
           "options:\n"
@@ -40,6 +47,18 @@ static int help_main(int argc, char **argv)
     }
     if (strcmp(argv[1], "run") == 0) {
         cs_run_help(stdout);
+        return CS_EXIT_OK;
+    }
+    if (strcmp(argv[1], "intersections") == 0) {
+        cs_intersections_help(stdout);
+        return CS_EXIT_OK;
+    }
+    if (strcmp(argv[1], "render") == 0) {
+        cs_render_help(stdout);
+        return CS_EXIT_OK;
+    }
+    if (strcmp(argv[1], "mesh-info") == 0 || strcmp(argv[1], "levelset") == 0) {
+        (argv[1][0] == 'm' ? cs_mesh_info_help : cs_levelset_help)(stdout);
         return CS_EXIT_OK;
     }
     if (strcmp(argv[1], "help") == 0) {
@@ -69,6 +88,14 @@ int main(int argc, char **argv)
     }
     if (strcmp(cmd, "run") == 0)
         return cs_run_main(argc - 1, argv + 1);
+    if (strcmp(cmd, "intersections") == 0)
+        return cs_intersections_main(argc - 1, argv + 1);
+    if (strcmp(cmd, "render") == 0)
+        return cs_render_main(argc - 1, argv + 1);
+    if (strcmp(cmd, "mesh-info") == 0)
+        return cs_mesh_info_main(argc - 1, argv + 1);
+    if (strcmp(cmd, "levelset") == 0)
+        return cs_levelset_main(argc - 1, argv + 1);
     if (strcmp(cmd, "help") == 0)
         return help_main(argc - 1, argv + 1);
 

@@ -11,6 +11,7 @@
 #include "app/run.h"
 
 #include "app/progress.h"
+#include "app/scene_render.h"
 #include "app/summary.h"
 #include "import/import.h"
 #include "sim/sim.h"
@@ -45,6 +46,8 @@ typedef struct run_options {
     char *frames_override;    /* owned "time.frames=N" */
     bool plan_only;
     bool quiet;
+    const char *render;       /* --render ENGINE, --size, --samples; NULL: none */
+    const char *render_size, *render_samples;
 } run_options;
 
 void cs_run_help(FILE *out)
@@ -70,6 +73,11 @@ void cs_run_help(FILE *out)
         "                       (glTF 2.0 binary); overrides the scene's output.format\n"
         "      --plan           print the stages a time step will run and the step size,\n"
         "                       then exit without simulating or writing anything\n"
+        "      --render ENGINE  also render each frame as DIR/images/frame_NNNN.png:\n"
+        "                       embree (ray traced) or preview (OSMesa); see\n"
+        "                       'clothsim render --help' for rendering after a run\n"
+        "      --size WxH       with --render: image size (default 640x480)\n"
+        "      --samples N      with --render: samples per pixel (default 16; preview 4)\n"
         "  -q, --quiet          no progress display\n"
         "  -h, --help           show this help\n"
         "\n"
@@ -95,7 +103,7 @@ static void usage_error(const char *fmt, const char *arg)
                     "'clothsim run --help' explains every option.\n");
 }
 
-enum { OPT_SET = 256, OPT_FORMAT, OPT_FRAMES, OPT_PLAN };
+enum { OPT_SET = 256, OPT_FORMAT, OPT_FRAMES, OPT_PLAN, OPT_RENDER, OPT_SIZE, OPT_SAMPLES };
 
 /* Returns -1 to go on, else an exit status. */
 static int parse_options(int argc, char **argv, run_options *o)
@@ -106,6 +114,9 @@ static int parse_options(int argc, char **argv, run_options *o)
         {"format", required_argument, NULL, OPT_FORMAT},
         {"frames", required_argument, NULL, OPT_FRAMES},
         {"plan", no_argument, NULL, OPT_PLAN},
+        {"render", required_argument, NULL, OPT_RENDER},
+        {"size", required_argument, NULL, OPT_SIZE},
+        {"samples", required_argument, NULL, OPT_SAMPLES},
         {"quiet", no_argument, NULL, 'q'},
         {"help", no_argument, NULL, 'h'},
         {NULL, 0, NULL, 0},
@@ -159,6 +170,15 @@ static int parse_options(int argc, char **argv, run_options *o)
         case OPT_PLAN:
             o->plan_only = true;
             break;
+        case OPT_RENDER:
+            o->render = optarg;
+            break;
+        case OPT_SIZE:
+            o->render_size = optarg;
+            break;
+        case OPT_SAMPLES:
+            o->render_samples = optarg;
+            break;
         case 'q':
             o->quiet = true;
             break;
@@ -187,6 +207,10 @@ static int parse_options(int argc, char **argv, run_options *o)
         return CS_EXIT_USAGE;
     }
     o->scene_path = argv[optind];
+    if ((o->render_size || o->render_samples) && !o->render) {
+        usage_error("%s", "--size and --samples go with --render ENGINE");
+        return CS_EXIT_USAGE;
+    }
     if (frames) {
         size_t len = strlen("time.frames=") + strlen(frames) + 1;
         o->frames_override = malloc(len);
@@ -348,6 +372,7 @@ typedef struct run_state {
     char *frames_dir;
     char *summary_path;
     cs_mesh_view *views;     /* one per cloth */
+    cs_run_render *render;   /* --render: an image per frame too */
     cs_summary summary;
     double start;            /* now_seconds() when the command began */
 } run_state;
@@ -368,6 +393,9 @@ static int write_frame(run_state *r, int frame, char *err, size_t errlen)
              cs_mesh_format_extension(r->format));
     double t0 = now_seconds();
     int rc = cs_mesh_write(path, r->format, ncloths, r->views, err, errlen);
+    if (rc == CS_IMPORT_OK && r->render && cs_run_render_frame(r->render, r->sim, frame, err,
+                                                               errlen) != 0)
+        rc = CS_IMPORT_BAD_INPUT;
     r->summary.output_seconds += now_seconds() - t0;
     if (rc == CS_IMPORT_OK)
         r->summary.frames_written = frame + 1;
@@ -514,12 +542,11 @@ static int simulate(run_state *r, const run_options *o)
         cs_frame_record rec = {
             .frame = frame,
             .time = cs_sim_time(r->sim),
-            .steps = stats.steps,
-            .dt = stats.dt,
-            .cg_iterations = stats.cg_iterations,
-            .body_contacts = stats.body_contacts,
-            .max_speed = stats.max_speed,
+            .stats = stats,
             .seconds = seconds,
+            .body_penetration = cs_plan_has(cs_sim_plan(r->sim), CS_STAGE_BODY_COLLISION)
+                                    ? cs_sim_body_penetration(r->sim)
+                                    : -1,
         };
         if (write_frame(r, frame, err, sizeof err) != CS_IMPORT_OK) {
             cs_progress_finish(&progress);
@@ -591,6 +618,8 @@ int cs_run_main(int argc, char **argv)
         goto done;
     }
     r.scene = scene;
+    for (int i = 0; i < scene->nnotes; i++) /* what import did with mesh files */
+        fprintf(stderr, "clothsim: %s\n", scene->notes[i]);
 
     const char *format_name = o.format ? o.format : scene->output_format;
     if (!format_name)
@@ -643,7 +672,10 @@ int cs_run_main(int argc, char **argv)
         triangles += cs_sim_cloth_mesh(r.sim, c)->nt;
     }
     s->scene = scene->name;
+    s->self_collision = scene->def.self_collision;
     s->scene_file = scene->path;
+    s->noverrides = o.noverrides;
+    s->overrides = (const char *const *)o.overrides;
     s->version = CS_VERSION;
     s->format = cs_mesh_format_extension(r.format);
     s->output_dir = r.out_dir;
@@ -655,10 +687,19 @@ int cs_run_main(int argc, char **argv)
     s->triangles = triangles;
     s->plan = *cs_sim_plan(r.sim);
 
+    if (o.render) {
+        r.render = cs_run_render_create(scene, r.sim, o.render, o.render_size, o.render_samples,
+                                        r.out_dir, &status);
+        if (!r.render) {
+            free(names);
+            goto done;
+        }
+    }
     status = simulate(&r, &o);
     free(names);
 
 done:
+    cs_run_render_destroy(r.render);
     cs_summary_free(&r.summary);
     free(r.views);
     free(r.out_dir);

@@ -97,6 +97,9 @@ static cJSON *build_json(const cs_summary *s, builder *b)
     }
     add_str(b, root, "scene", s->scene);
     add_str(b, root, "scene_file", s->scene_file);
+    cJSON *overrides = add_array(b, root, "overrides");
+    for (int i = 0; i < s->noverrides; i++)
+        append(b, overrides, cJSON_CreateString(s->overrides[i]));
     add_str(b, root, "clothsim_version", s->version);
     add_str(b, root, "status", s->status);
     if (s->error)
@@ -142,11 +145,25 @@ static cJSON *build_json(const cs_summary *s, builder *b)
         if (o) {
             add_num(b, o, "frame", f->frame);
             add_num(b, o, "time", f->time);
-            add_num(b, o, "steps", f->steps);
-            add_num(b, o, "dt", f->dt);
-            add_num(b, o, "cg_iterations", (double)f->cg_iterations);
-            add_num(b, o, "body_contacts", (double)f->body_contacts);
-            add_num(b, o, "max_speed", f->max_speed);
+            const cs_frame_stats *st = &f->stats;
+            add_num(b, o, "steps", st->steps);
+            add_num(b, o, "dt", st->dt);
+            add_num(b, o, "cg_iterations", (double)st->cg_iterations);
+            add_num(b, o, "body_contacts", (double)st->body_contacts);
+            add_num(b, o, "max_speed", st->max_speed);
+            if (s->self_collision) {
+                add_num(b, o, "repulsion_pairs", (double)st->repulsion_pairs);
+                add_num(b, o, "repulsions", (double)st->repulsions);
+                add_num(b, o, "collisions", (double)st->collisions);
+                add_num(b, o, "collision_passes", (double)st->collision_passes);
+                add_num(b, o, "impact_zones", (double)st->impact_zones);
+                add_num(b, o, "max_zone_size", (double)st->max_zone_size);
+                add_num(b, o, "rewinds", (double)st->rewinds);
+            }
+            if (st->intersections >= 0)
+                add_num(b, o, "intersections", (double)st->intersections);
+            if (f->body_penetration >= 0)
+                add_num(b, o, "body_penetration_max", f->body_penetration);
             add_num(b, o, "seconds", f->seconds);
         }
         append(b, frames, o);

@@ -7,6 +7,7 @@
 #ifndef CS_APP_SUMMARY_H
 #define CS_APP_SUMMARY_H
 
+#include <stdbool.h>
 #include <stddef.h>
 #include <stdio.h>
 
@@ -16,23 +17,24 @@
 typedef struct cs_frame_record {
     int frame;
     double time;            /* simulated time at the end of the frame, s */
-    int steps;
-    double dt;
-    long cg_iterations;
-    long body_contacts;
-    double max_speed;       /* m/s */
+    cs_frame_stats stats;   /* the simulation's counters for the frame */
     double seconds;         /* wall time cs_sim_advance_frame took */
+    double body_penetration; /* deepest free vertex inside a body at the frame's
+                                end, m (cs_sim_body_penetration); < 0: no bodies */
 } cs_frame_record;
 
 typedef struct cs_summary {
     /* Borrowed strings, alive as long as the summary. */
     const char *scene;
     const char *scene_file;
+    int noverrides;                  /* the run's --set overrides, as given, so */
+    const char *const *overrides;    /* `clothsim render` can reload the scene */
     const char *version;
     const char *format;              /* "ply", "obj", "glb" */
     const char *output_dir;
     const char *status;              /* "running", "ok", "unstable", "interrupted", "failed" */
     const char *error;               /* why, when not "ok"; NULL otherwise */
+    bool self_collision;             /* frames carry the self-collision counters */
     int failed_frame;                /* the frame that went unstable, else -1 */
     int frames_requested;            /* simulated frames asked for */
     int frames_written;              /* files on disk, frame 0 included */

@@ -4,6 +4,7 @@
 #define CS_INTERNAL_H
 
 #include "sim/sim.h"
+#include "sim/selfcol.h"
 #include "sim/springs.h"
 
 /* What the solver may change about a particle's velocity. */
@@ -50,6 +51,9 @@ struct cs_sim {
     /* body stages only */
     double *contact_normal;       /* 3 per particle */
     int *contact_body;            /* -1 when not in contact */
+    /* self-collision stages only */
+    cs_selfcol *selfcol;
+    double *v_rewind;             /* rewind scheme: velocities at the outer step's start */
     /* wind stage only */
     double *wind_normal;          /* 3 per particle, area weighted unit normal */
     double *wind_area;            /* 1 per particle */

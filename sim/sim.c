@@ -90,9 +90,11 @@ static int validate(const cs_sim_def *def, char *err, size_t errlen)
 {
     if (def->ncloths < 1)
         return fail(err, errlen, "a scene needs at least one cloth");
-    if (def->self_collision) /* never a silent wrong result: refuse, do not ignore */
-        return fail(err, errlen, "self-collision (Sections 4 and 5) is not available in this "
-                                 "version; set effects.self_collision to false");
+    if (def->self_collision &&
+        (!(def->self.thickness > 0) || !(def->self.stiffness >= 0) || !(def->self.friction >= 0) ||
+         def->self.zone_iterations < 1))
+        return fail(err, errlen, "self-collision needs thickness > 0, stiffness and friction "
+                                 ">= 0, zone_iterations >= 1");
     if (!(def->fps > 0))
         return fail(err, errlen, "fps must be > 0");
     if (!(def->dt >= 0) || !(def->dt_safety > 0 && def->dt_safety <= 1))
@@ -124,6 +126,8 @@ static int validate(const cs_sim_def *def, char *err, size_t errlen)
         const cs_body_def *body = def->bodies + b;
         if ((unsigned)body->shape >= CS_BODY_SHAPE_COUNT)
             return fail(err, errlen, "body %d: unknown shape", b);
+        if (body->shape == CS_BODY_MESH && !body->phi_fn) /* never a silent plane */
+            return fail(err, errlen, "body %d: a mesh body needs its level set", b);
         if (!(body->friction >= 0))
             return fail(err, errlen, "body %d: friction must be >= 0", b);
     }
@@ -305,6 +309,19 @@ cs_sim *cs_sim_create(const cs_sim_def *def, char *err, size_t errlen)
         sim->stage_bytes[CS_STAGE_WIND] = 4 * sizeof(double) * (size_t)n;
     }
 
+    if (cs_plan_has(&sim->plan, CS_STAGE_COLLISIONS)) {
+        sim->selfcol = cs_selfcol_create(sim);
+        if (!sim->selfcol)
+            goto nomem;
+        sim->stage_bytes[CS_STAGE_COLLISIONS] = sim->selfcol->bytes;
+        if (def->self.scheme == CS_COLLISION_REWIND) {
+            sim->v_rewind = alloc3(n);
+            if (!sim->v_rewind)
+                goto nomem;
+            sim->stage_bytes[CS_STAGE_COLLISIONS] += 3 * sizeof(double) * (size_t)n;
+        }
+    }
+
     /* time step: the explicit elastic forces are stable for dt < 2 / omega_max
      * (the scheme's amplification matrix has determinant 1 and trace
      * 2 - dt^2 omega^2); omega_max^2 is bounded by Gershgorin. */
@@ -343,9 +360,10 @@ void cs_sim_destroy(cs_sim *sim)
         free((void *)sim->bodies[b].motion.keys);
     free(sim->bodies);
     cs_springs_free(&sim->springs);
+    cs_selfcol_destroy(sim->selfcol);
     double *arrays[] = {sim->x, sim->v, sim->mass, sim->x_prev, sim->v_half, sim->v_star,
                         sim->v_next, sim->force, sim->v0, sim->rhs, sim->script_x,
-                        sim->script_v, sim->contact_normal, sim->wind_normal, sim->wind_area,
+                        sim->script_v, sim->contact_normal, sim->wind_normal, sim->wind_area, sim->v_rewind,
                         sim->cg.z, sim->cg.r, sim->cg.y, sim->cg.p, sim->cg.q, sim->cg.diag,
                         sim->cg.b};
     for (size_t k = 0; k < sizeof arrays / sizeof *arrays; k++)
@@ -467,6 +485,13 @@ int cs_sim_step(cs_sim *sim, double dt)
     sim->cg_iterations += cs_cg_solve(sim, sim->v0, sim->rhs, sim->v_half);
     STAGE_END(sim, CS_STAGE_VELOCITY_HALF);
 
+    /* B.2: repulsions change only the velocity that moves the positions */
+    if (sim->selfcol) {
+        STAGE_BEGIN(sim, CS_STAGE_SELF_REPULSION);
+        cs_selfcol_repulse(sim, sim->x, sim->v_half, dt, true);
+        STAGE_END(sim, CS_STAGE_SELF_REPULSION);
+    }
+
     /* B.3 */
     STAGE_BEGIN(sim, CS_STAGE_POSITION_UPDATE);
     for (int k = 0; k < n3; k++)
@@ -526,6 +551,12 @@ int cs_sim_step(cs_sim *sim, double dt)
         cs_body_friction(sim, dt);
         STAGE_END(sim, CS_STAGE_BODY_FRICTION);
     }
+    /* B.8: inelastic repulsion and friction on the final velocity */
+    if (sim->selfcol) {
+        STAGE_BEGIN(sim, CS_STAGE_SELF_FRICTION);
+        cs_selfcol_repulse(sim, sim->x, sim->v_next, dt, false);
+        STAGE_END(sim, CS_STAGE_SELF_FRICTION);
+    }
     memcpy(sim->v, sim->v_next, sizeof(double) * (size_t)n3);
     sim->t = t1;
 
@@ -535,19 +566,85 @@ int cs_sim_step(cs_sim *sim, double dt)
     return CS_OK;
 }
 
+static bool state_finite(const cs_sim *sim)
+{
+    for (int k = 0; k < 3 * sim->n; k++)
+        if (!isfinite(sim->x[k]) || !isfinite(sim->v[k]))
+            return false;
+    return true;
+}
+
+/* One outer collision step of k time steps (Section 4): step A, k steps of
+ * B, step C. The rewind scheme (Bridson et al. 2002) first runs the k steps
+ * and, if step C would find a collision, goes back and tries again with k
+ * halved, until k = 1. Returns CS_OK or CS_ERR_UNSTABLE. */
+static int outer_step(cs_sim *sim, int k)
+{
+    cs_selfcol *sc = sim->selfcol;
+    if (!sc) {
+        for (int i = 0; i < k; i++)
+            if (cs_sim_step(sim, sim->dt) != CS_OK)
+                return CS_ERR_UNSTABLE;
+        return CS_OK;
+    }
+    bool rewind = sim->def.self.scheme == CS_COLLISION_REWIND;
+    size_t bytes = sizeof(double) * 3 * (size_t)sim->n;
+    double t0 = sim->t;
+    if (rewind) /* keep the start to come back to; x equals x_free here */
+        memcpy(sim->v_rewind, sim->v, bytes);
+    for (;;) {
+        STAGE_BEGIN(sim, CS_STAGE_REPULSION_PAIRS);
+        cs_selfcol_find_pairs(sim, k * sim->dt);
+        STAGE_END(sim, CS_STAGE_REPULSION_PAIRS);
+        for (int i = 0; i < k; i++)
+            if (cs_sim_step(sim, sim->dt) != CS_OK)
+                return CS_ERR_UNSTABLE;
+        if (rewind && k > 1) {
+            STAGE_BEGIN(sim, CS_STAGE_COLLISIONS);
+            long found = cs_selfcol_collide(sim, sim->t - t0, k, true);
+            STAGE_END(sim, CS_STAGE_COLLISIONS);
+            if (found > 0) {
+                memcpy(sim->x, sc->x_free, bytes);
+                memcpy(sim->v, sim->v_rewind, bytes);
+                sim->t = t0;
+                sc->stats.rewinds++;
+                /* the halves run one after another, each from its own start */
+                int first = k / 2, status = outer_step(sim, first);
+                if (status != CS_OK)
+                    return status;
+                return outer_step(sim, k - first);
+            }
+        }
+        STAGE_BEGIN(sim, CS_STAGE_COLLISIONS);
+        cs_selfcol_collide(sim, sim->t - t0, k, false);
+        STAGE_END(sim, CS_STAGE_COLLISIONS);
+        return state_finite(sim) ? CS_OK : CS_ERR_UNSTABLE;
+    }
+}
+
 int cs_sim_advance_frame(cs_sim *sim, cs_frame_stats *stats)
 {
     double frame = 1.0 / sim->def.fps;
     int steps = (int)lround(frame / sim->dt);
     long cg0 = sim->cg_iterations, contacts0 = sim->contacts;
+    cs_selfcol_stats self0 = {0};
+    if (sim->selfcol) {
+        sim->selfcol->stats.max_zone = 0; /* the largest zone of this frame */
+        self0 = sim->selfcol->stats;
+    }
     int status = CS_OK;
-    /* The outer collision loop: k_i time steps, then (with self-collision,
-     * issue 3) step C. Chunks never straddle a frame end. */
+    /* The outer collision loop: k_i time steps, then step C. Chunks never
+     * straddle a frame end, so every frame ends collision-free. */
     for (int s = 0; s < steps && status == CS_OK;) {
         int chunk = steps - s < sim->def.collision_steps ? steps - s : sim->def.collision_steps;
-        for (int k = 0; k < chunk && status == CS_OK; k++)
-            status = cs_sim_step(sim, sim->dt);
+        status = outer_step(sim, chunk);
         s += chunk;
+    }
+    long intersections = -1;
+    if (status == CS_OK && cs_plan_has(&sim->plan, CS_STAGE_VERIFY)) {
+        STAGE_BEGIN(sim, CS_STAGE_VERIFY);
+        intersections = cs_sim_count_intersections(sim);
+        STAGE_END(sim, CS_STAGE_VERIFY);
     }
     if (stats) {
         memset(stats, 0, sizeof *stats);
@@ -560,8 +657,40 @@ int cs_sim_advance_frame(cs_sim *sim, cs_frame_stats *stats)
             if (s > stats->max_speed)
                 stats->max_speed = s;
         }
+        if (sim->selfcol) {
+            const cs_selfcol_stats *now = &sim->selfcol->stats;
+            stats->repulsion_pairs = now->repulsion_pairs - self0.repulsion_pairs;
+            stats->repulsions = now->repulsions - self0.repulsions;
+            stats->collisions = now->collisions - self0.collisions;
+            stats->collision_passes = now->passes - self0.passes;
+            stats->impact_zones = now->zones - self0.zones;
+            stats->max_zone_size = now->max_zone;
+            stats->rewinds = now->rewinds - self0.rewinds;
+        }
+        stats->intersections = intersections;
     }
     return status;
+}
+
+long cs_sim_count_intersections(const cs_sim *sim)
+{
+    /* every cloth's triangles in global particle indices, as one mesh */
+    long nt = 0;
+    for (int c = 0; c < sim->ncloths; c++)
+        nt += sim->cloths[c].mesh->nt;
+    int *tri = malloc(sizeof *tri * 3 * (size_t)(nt + 1));
+    if (!tri)
+        return -1;
+    long t = 0;
+    for (int c = 0; c < sim->ncloths; c++) {
+        const cs_trimesh *m = sim->cloths[c].mesh;
+        for (int k = 0; k < 3 * m->nt; k++)
+            tri[3 * t + k] = sim->cloths[c].offset + m->tri[k];
+        t += m->nt;
+    }
+    long count = cs_count_intersections(sim->n, sim->x, (int)nt, tri);
+    free(tri);
+    return count;
 }
 
 double cs_sim_time(const cs_sim *sim) { return sim->t; }

@@ -102,6 +102,7 @@ typedef enum cs_body_shape {
     CS_BODY_SPHERE,      /* radius, centred at the local origin */
     CS_BODY_BOX,         /* half_extents, centred at the local origin */
     CS_BODY_CYLINDER,    /* radius, half_height, axis local y, capped */
+    CS_BODY_MESH,        /* a level set from a mesh: phi_fn is required */
     CS_BODY_SHAPE_COUNT
 } cs_body_shape;
 
@@ -120,6 +121,10 @@ typedef struct cs_body_def {
     /* Optional: a user distance function replacing the analytic shape. */
     cs_body_phi_fn phi_fn;
     const void *phi_data;
+    /* With phi_fn: a local box outside which phi > 0, so that the body is
+     * only asked about points near it; without one, about every point. */
+    bool phi_bounded;
+    double phi_min[3], phi_max[3];
 } cs_body_def;
 
 cs_body_def cs_default_body_def(void);
@@ -129,6 +134,10 @@ double cs_body_def_phi(const cs_body_def *b, double t, const double x[3], double
 
 /* Velocity at time t of the body material point at world position x. */
 void cs_body_def_velocity(const cs_body_def *b, double t, const double x[3], double v[3]);
+
+/* A world box at time t holding every point where the body's phi < 0.
+ * False for an unbounded body (a plane, or phi_fn without phi_bounded). */
+bool cs_body_def_bounds(const cs_body_def *b, double t, double lo[3], double hi[3]);
 
 /* ---------------------------------------------------------------- cloth */
 
@@ -228,13 +237,18 @@ cs_sim_def cs_default_sim_def(void);
 /* The stages a step can contain, in the order they run. A plan holds only
  * the ones the scene calls for; the others are neither run nor allocated. */
 typedef enum cs_stage {
-    CS_STAGE_SCRIPTED_VERTICES = 0, /* prescribed positions and velocities */
+    CS_STAGE_REPULSION_PAIRS = 0,   /* A: repulsion pairs and their history */
+    CS_STAGE_SCRIPTED_VERTICES,     /* prescribed positions and velocities */
     CS_STAGE_WIND,                  /* normals and areas for wind drag */
     CS_STAGE_VELOCITY_HALF,         /* B.1 backward Euler half step (CG) */
+    CS_STAGE_SELF_REPULSION,        /* B.2 inelastic and elastic repulsion */
     CS_STAGE_POSITION_UPDATE,       /* B.3 */
     CS_STAGE_BODY_COLLISION,        /* B.4 crossing point, Gamma */
     CS_STAGE_VELOCITY_FULL,         /* B.5 projected solve (CG), B.6 */
     CS_STAGE_BODY_FRICTION,         /* B.7 Gamma on v_NP */
+    CS_STAGE_SELF_FRICTION,         /* B.8 inelastic repulsion and friction */
+    CS_STAGE_COLLISIONS,            /* C: continuous collisions, impact zones */
+    CS_STAGE_VERIFY,                /* intersecting triangle pairs at frame end */
     CS_STAGE_COUNT
 } cs_stage;
 
@@ -262,6 +276,15 @@ typedef struct cs_frame_stats {
     long cg_iterations;
     long body_contacts;        /* particle-steps in contact with a body */
     double max_speed;          /* m/s at the end of the frame */
+    /* self-collision (zero when it is off) */
+    long repulsion_pairs;      /* pairs found by step A, summed over outer steps */
+    long repulsions;           /* pair impulses applied in B.2 and B.8 */
+    long collisions;           /* colliding pairs found by step C */
+    long collision_passes;     /* step C iterations */
+    long impact_zones;         /* zones formed */
+    long max_zone_size;        /* particles in the largest zone */
+    long rewinds;              /* outer steps redone (rewind scheme) */
+    long intersections;        /* verifier at frame end; -1 when not asked */
 } cs_frame_stats;
 
 /* ------------------------------------------------------------ simulation */
@@ -277,6 +300,10 @@ int cs_sim_advance_frame(cs_sim *sim, cs_frame_stats *stats);
 
 /* Advances by exactly one time step of the integrator (for tests). */
 int cs_sim_step(cs_sim *sim, double dt);
+
+/* Intersecting pairs of non-adjacent triangles over all cloths now, by the
+ * independent verifier (cs_count_intersections). */
+long cs_sim_count_intersections(const cs_sim *sim);
 
 double cs_sim_time(const cs_sim *sim);
 double cs_sim_dt(const cs_sim *sim);          /* step used by advance_frame */
@@ -296,6 +323,43 @@ const cs_plan *cs_sim_plan(const cs_sim *sim);
 const cs_stage_timing *cs_sim_stage_timing(const cs_sim *sim); /* CS_STAGE_COUNT entries */
 /* Bytes the simulation allocated for a stage's own data (0 if absent). */
 size_t cs_sim_stage_bytes(const cs_sim *sim, cs_stage stage);
+
+/* How deep the deepest free cloth vertex is inside a body now: the largest
+ * -phi over free vertices and bodies, 0 when none is inside (or body
+ * collisions are off). */
+double cs_sim_body_penetration(const cs_sim *sim);
+
+/* ---------------------------------------------------------- tessellation */
+
+/* A triangle mesh of an analytic body at time t, in world coordinates, for
+ * drawing: `detail` segments around spheres and cylinders (at least 3); a
+ * plane becomes a square of half-size plane_extent about its frame origin.
+ * Triangles wind counter-clockwise seen from outside (outward normals);
+ * vertices are shared only across smooth parts, so box edges and cylinder
+ * caps stay sharp under smooth shading. NULL for a body given by phi_fn,
+ * an invalid size, or no memory. Free with cs_trimesh_destroy. */
+cs_trimesh *cs_body_def_tessellate(const cs_body_def *b, double t, double plane_extent,
+                                   int detail);
+
+/* ----------------------------------------------------- self-intersection */
+
+/* The verifier (sim/verify.c), independent of the collision code: counts
+ * the unordered pairs of triangles that share no vertex index and intersect
+ * as closed sets. Touching counts, so does coplanar overlap; a degenerate
+ * triangle counts as the segment or point it is. Exact for every finite
+ * input (filtered floating point, expansion arithmetic, GMP). Returns the
+ * count, or CS_ERR_INVALID (an index out of range, a non-finite coordinate
+ * of a used vertex, a negative size) or CS_ERR_NOMEM. */
+long cs_count_intersections(int nv, const double *x, int nt, const int *tri);
+
+/* The same, also writing the first min(count, maxpairs) intersecting pairs
+ * in increasing order, pair k as triangles pairs[2k] < pairs[2k + 1]. */
+long cs_find_intersections(int nv, const double *x, int nt, const int *tri, int maxpairs,
+                           int *pairs);
+
+/* The exact narrow phase alone: whether the closed triangles p and q
+ * (3 vertices of 3 doubles each, possibly degenerate) intersect. */
+bool cs_triangles_intersect(const double p[9], const double q[9]);
 
 #ifdef __cplusplus
 }

@@ -74,9 +74,11 @@ err_has '--set'
 run 2 run tiny.yaml --plan --set time.frames=two
 [ ! -e out ] || fail "an invalid scene wrote output"
 
-# --- an effect this version cannot simulate is refused, not ignored
-run 2 run tiny.yaml --set effects.self_collision=true
-err_has 'self-collision'
+# --- self-collision settings are checked like every other key
+run 2 run tiny.yaml --set effects.self_collision=true --set self_collision.thickness=0
+err_has 'self_collision.thickness'
+run 2 run tiny.yaml --set self_collision.scheme=sometimes
+err_has 'fixed, rewind'
 [ ! -e out ] || fail "a refused scene wrote output"
 
 # --- output that cannot be written: status 4, the message names the path

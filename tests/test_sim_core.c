@@ -384,7 +384,9 @@ static void test_plan_omits_absent_stages(void **state)
     assert_int_equal(cs_sim_advance_frame(sim, NULL), CS_OK);
     const cs_stage_timing *t = cs_sim_stage_timing(sim);
     cs_stage absent[] = {CS_STAGE_BODY_COLLISION, CS_STAGE_BODY_FRICTION, CS_STAGE_WIND,
-                         CS_STAGE_SCRIPTED_VERTICES};
+                         CS_STAGE_SCRIPTED_VERTICES, CS_STAGE_REPULSION_PAIRS,
+                         CS_STAGE_SELF_REPULSION, CS_STAGE_SELF_FRICTION, CS_STAGE_COLLISIONS,
+                         CS_STAGE_VERIFY};
     for (size_t k = 0; k < sizeof absent / sizeof *absent; k++) {
         assert_int_equal(t[absent[k]].calls, 0);
         assert_true(t[absent[k]].seconds == 0);
@@ -392,6 +394,7 @@ static void test_plan_omits_absent_stages(void **state)
     }
     assert_null(sim->contact_normal);
     assert_null(sim->wind_normal);
+    assert_null(sim->selfcol); /* self-collision off: no hierarchy, no pairs */
     assert_true(t[CS_STAGE_VELOCITY_HALF].calls > 0);
     cs_sim_destroy(sim);
 
@@ -416,6 +419,22 @@ static void test_plan_omits_absent_stages(void **state)
     /* the pinned vertex has not moved */
     for (int d = 0; d < 3; d++)
         assert_true(cs_sim_positions(sim)[d] == mesh->x[d]);
+    cs_sim_destroy(sim);
+
+    /* self-collision on: its four stages run and own their memory */
+    def.self_collision = true;
+    sim = cs_sim_create(&def, NULL, 0);
+    assert_non_null(sim);
+    cs_stage self_stages[] = {CS_STAGE_REPULSION_PAIRS, CS_STAGE_SELF_REPULSION,
+                              CS_STAGE_SELF_FRICTION, CS_STAGE_COLLISIONS};
+    assert_int_equal(cs_sim_advance_frame(sim, NULL), CS_OK);
+    t = cs_sim_stage_timing(sim);
+    for (size_t k = 0; k < 4; k++) {
+        assert_true(cs_plan_has(cs_sim_plan(sim), self_stages[k]));
+        assert_true(t[self_stages[k]].calls > 0);
+    }
+    assert_true(cs_sim_stage_bytes(sim, CS_STAGE_COLLISIONS) > 0);
+    assert_false(cs_plan_has(cs_sim_plan(sim), CS_STAGE_VERIFY)); /* not asked for */
     cs_sim_destroy(sim);
     cs_trimesh_destroy(mesh);
 }

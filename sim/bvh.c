@@ -1,0 +1,195 @@
+/* bvh.c: build, refit and pair traversal of box hierarchies. */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "sim/bvh.h"
+
+enum { LEAF_SIZE = 4 };
+
+typedef struct builder {
+    cs_bvh *t;
+    const cs_box *pb;
+    double *centroid; /* 3 per primitive */
+    int axis;
+} builder;
+
+static builder *sort_ctx; /* qsort has no context argument in C11 */
+
+static int by_centroid(const void *pa, const void *pb)
+{
+    double a = sort_ctx->centroid[3 * *(const int *)pa + sort_ctx->axis];
+    double b = sort_ctx->centroid[3 * *(const int *)pb + sort_ctx->axis];
+    return (a > b) - (a < b);
+}
+
+static int build_node(builder *b, int first, int count)
+{
+    cs_bvh *t = b->t;
+    int node = t->nnodes++;
+    t->first[node] = first;
+    t->count[node] = count;
+    t->child[2 * node] = t->child[2 * node + 1] = -1;
+    if (count <= LEAF_SIZE)
+        return node;
+    cs_box c;
+    cs_box_empty(&c);
+    for (int k = first; k < first + count; k++)
+        cs_box_add_point(&c, b->centroid + 3 * t->order[k]);
+    int axis = 0;
+    for (int d = 1; d < 3; d++)
+        if (c.hi[d] - c.lo[d] > c.hi[axis] - c.lo[axis])
+            axis = d;
+    b->axis = axis;
+    sort_ctx = b;
+    qsort(t->order + first, (size_t)count, sizeof *t->order, by_centroid);
+    int half = count / 2;
+    int left = build_node(b, first, half);
+    int right = build_node(b, first + half, count - half);
+    t->child[2 * node] = left;
+    t->child[2 * node + 1] = right;
+    return node;
+}
+
+int cs_bvh_build(cs_bvh *t, int nprims, const cs_box *pb)
+{
+    memset(t, 0, sizeof *t);
+    t->nprims = nprims;
+    int cap = 2 * (nprims > 0 ? nprims : 1);
+    t->box = calloc((size_t)cap, sizeof *t->box);
+    t->child = calloc(2 * (size_t)cap, sizeof *t->child);
+    t->first = calloc((size_t)cap, sizeof *t->first);
+    t->count = calloc((size_t)cap, sizeof *t->count);
+    t->order = calloc((size_t)nprims + 1, sizeof *t->order);
+    t->dirty = calloc((size_t)cap, 1);
+    builder b = {t, pb, calloc(3 * (size_t)nprims + 3, sizeof(double)), 0};
+    if (!t->box || !t->child || !t->first || !t->count || !t->order || !t->dirty || !b.centroid) {
+        free(b.centroid);
+        cs_bvh_free(t);
+        return -1;
+    }
+    for (int i = 0; i < nprims; i++) {
+        t->order[i] = i;
+        for (int d = 0; d < 3; d++)
+            b.centroid[3 * i + d] = 0.5 * (pb[i].lo[d] + pb[i].hi[d]);
+    }
+    if (nprims > 0)
+        build_node(&b, 0, nprims);
+    free(b.centroid);
+    cs_bvh_refit(t, pb, NULL);
+    return 0;
+}
+
+void cs_bvh_free(cs_bvh *t)
+{
+    free(t->box);
+    free(t->child);
+    free(t->first);
+    free(t->count);
+    free(t->order);
+    free(t->dirty);
+    memset(t, 0, sizeof *t);
+}
+
+void cs_bvh_refit(cs_bvh *t, const cs_box *pb, const unsigned char *prim_dirty)
+{
+    for (int node = t->nnodes - 1; node >= 0; node--) {
+        cs_box *b = t->box + node;
+        int l = t->child[2 * node];
+        if (l < 0) {
+            cs_box_empty(b);
+            unsigned char dirty = 0;
+            for (int k = t->first[node]; k < t->first[node] + t->count[node]; k++) {
+                int p = t->order[k];
+                cs_box_add_point(b, pb[p].lo);
+                cs_box_add_point(b, pb[p].hi);
+                dirty |= prim_dirty ? prim_dirty[p] : 0;
+            }
+            t->dirty[node] = dirty;
+        } else {
+            int r = t->child[2 * node + 1];
+            *b = t->box[l];
+            cs_box_add_point(b, t->box[r].lo);
+            cs_box_add_point(b, t->box[r].hi);
+            t->dirty[node] = t->dirty[l] | t->dirty[r];
+        }
+    }
+}
+
+typedef struct traversal {
+    const cs_bvh *A, *B;
+    const cs_box *box_a, *box_b;
+    bool self, only_dirty;
+    cs_bvh_pair_fn fn;
+    void *ctx;
+} traversal;
+
+static void leaf_pairs(const traversal *tr, int i, int j)
+{
+    const cs_bvh *A = tr->A, *B = tr->B;
+    for (int ka = A->first[i]; ka < A->first[i] + A->count[i]; ka++) {
+        int a = A->order[ka];
+        int kb0 = (tr->self && i == j) ? ka + 1 : B->first[j];
+        for (int kb = kb0; kb < B->first[j] + B->count[j]; kb++) {
+            int b = B->order[kb];
+            if (!cs_box_overlap(tr->box_a + a, tr->box_b + b))
+                continue;
+            if (tr->self && a > b)
+                tr->fn(tr->ctx, b, a);
+            else
+                tr->fn(tr->ctx, a, b);
+        }
+    }
+}
+
+static void descend(const traversal *tr, int i, int j)
+{
+    const cs_bvh *A = tr->A, *B = tr->B;
+    if (tr->only_dirty && !A->dirty[i] && !B->dirty[j])
+        return;
+    if (tr->self && i == j) {
+        int l = A->child[2 * i];
+        if (l < 0) {
+            leaf_pairs(tr, i, i);
+            return;
+        }
+        int r = A->child[2 * i + 1];
+        descend(tr, l, l);
+        descend(tr, r, r);
+        descend(tr, l, r);
+        return;
+    }
+    if (!cs_box_overlap(A->box + i, B->box + j))
+        return;
+    int la = A->child[2 * i], lb = B->child[2 * j];
+    if (la < 0 && lb < 0) {
+        leaf_pairs(tr, i, j);
+        return;
+    }
+    /* split the larger box (or the only inner node) */
+    bool split_a = lb < 0;
+    if (la >= 0 && lb >= 0) {
+        double va = 1, vb = 1;
+        for (int d = 0; d < 3; d++) {
+            va *= A->box[i].hi[d] - A->box[i].lo[d];
+            vb *= B->box[j].hi[d] - B->box[j].lo[d];
+        }
+        split_a = va >= vb;
+    }
+    if (split_a) {
+        descend(tr, la, j);
+        descend(tr, A->child[2 * i + 1], j);
+    } else {
+        descend(tr, i, lb);
+        descend(tr, i, B->child[2 * j + 1]);
+    }
+}
+
+void cs_bvh_pairs(const cs_bvh *A, const cs_bvh *B, const cs_box *box_a, const cs_box *box_b,
+                  bool only_dirty, cs_bvh_pair_fn fn, void *ctx)
+{
+    if (A->nnodes == 0 || B->nnodes == 0)
+        return;
+    traversal tr = {A, B, box_a, box_b, A == B, only_dirty, fn, ctx};
+    descend(&tr, 0, 0);
+}

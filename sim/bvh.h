@@ -1,0 +1,71 @@
+/* bvh.h: axis-aligned bounding box hierarchies over points, segments and
+ * triangles (van den Bergen 1997, the paper's [49]), private to sim/.
+ * The topology is built once from the primitives' boxes at creation (median
+ * split of centroids along the widest axis); every use refits the boxes
+ * bottom-up. Nodes are stored parents before children, so a reverse sweep
+ * refits. A dirty flag per node lets repeated searches skip subtrees whose
+ * primitives did not change. */
+#ifndef CS_BVH_H
+#define CS_BVH_H
+
+#include <math.h>
+#include <stdbool.h>
+
+typedef struct cs_box {
+    double lo[3], hi[3];
+} cs_box;
+
+typedef struct cs_bvh {
+    int nprims, nnodes;
+    cs_box *box;          /* per node */
+    int *child;           /* 2 per node: left, right; -1 for a leaf */
+    int *first, *count;   /* leaf: primitives order[first .. first+count) */
+    int *order;           /* primitive ids in leaf order */
+    unsigned char *dirty; /* per node, from cs_bvh_refit's dirty input */
+} cs_bvh;
+
+int cs_bvh_build(cs_bvh *t, int nprims, const cs_box *prim_box);
+void cs_bvh_free(cs_bvh *t);
+/* Sets node boxes from primitive boxes; prim_dirty may be NULL (all clean). */
+void cs_bvh_refit(cs_bvh *t, const cs_box *prim_box, const unsigned char *prim_dirty);
+
+/* Calls fn(ctx, a, b) for every pair of primitives a of A and b of B whose
+ * boxes overlap (for A == B each unordered pair a < b once). With
+ * only_dirty, node pairs where neither side is dirty are skipped. */
+typedef void (*cs_bvh_pair_fn)(void *ctx, int a, int b);
+void cs_bvh_pairs(const cs_bvh *A, const cs_bvh *B, const cs_box *box_a, const cs_box *box_b,
+                  bool only_dirty, cs_bvh_pair_fn fn, void *ctx);
+
+static inline bool cs_box_overlap(const cs_box *a, const cs_box *b)
+{
+    return a->lo[0] <= b->hi[0] && b->lo[0] <= a->hi[0] && a->lo[1] <= b->hi[1] &&
+           b->lo[1] <= a->hi[1] && a->lo[2] <= b->hi[2] && b->lo[2] <= a->hi[2];
+}
+
+static inline void cs_box_empty(cs_box *b)
+{
+    for (int d = 0; d < 3; d++) {
+        b->lo[d] = INFINITY;
+        b->hi[d] = -INFINITY;
+    }
+}
+
+static inline void cs_box_add_point(cs_box *b, const double p[3])
+{
+    for (int d = 0; d < 3; d++) {
+        if (p[d] < b->lo[d])
+            b->lo[d] = p[d];
+        if (p[d] > b->hi[d])
+            b->hi[d] = p[d];
+    }
+}
+
+static inline void cs_box_thicken(cs_box *b, double h)
+{
+    for (int d = 0; d < 3; d++) {
+        b->lo[d] -= h;
+        b->hi[d] += h;
+    }
+}
+
+#endif

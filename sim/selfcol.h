@@ -1,0 +1,87 @@
+/* selfcol.h: self-collisions of Sections 4 and 5, private to sim/.
+ *
+ * Step A finds repulsion pairs in the collision-free state with their
+ * history (orientation); B.2 and B.8 apply them every time step; step C
+ * finds and removes collisions along the linear trajectories from the
+ * collision-free state, with impact zones as the last resort. Every set of
+ * pairs goes through one Gauss-Seidel routine (cs_pairs_apply), the door the
+ * parallel version (Section 7) replaces. */
+#ifndef CS_SELFCOL_H
+#define CS_SELFCOL_H
+
+#include "sim/bvh.h"
+
+typedef struct cs_sim cs_sim;
+
+/* A point/triangle pair is (t0, t1, t2, point), the triangle wound so its
+ * normal pointed at the point in the collision-free state. An edge/edge
+ * pair is (a0, a1, b0, b1) with s0 the unit shortest vector from edge a to
+ * edge b in the collision-free state. */
+typedef struct cs_pair {
+    int v[4];
+    double s0[3];
+} cs_pair;
+
+typedef struct cs_pair_list {
+    int n, capacity;
+    cs_pair *p;
+} cs_pair_list;
+
+typedef struct cs_selfcol_stats {
+    long repulsion_pairs;      /* found by step A (summed over outer steps) */
+    long repulsions;           /* pair impulses applied in B.2 and B.8 */
+    long collisions;           /* collisions found by step C */
+    long passes;               /* step C iterations */
+    long zones;                /* impact zones formed */
+    long max_zone;             /* particles in the largest zone */
+    long rewinds;              /* outer steps redone (rewind scheme) */
+} cs_selfcol_stats;
+
+typedef struct cs_selfcol {
+    int n, ne, nt;
+    int *edge, *tri;           /* global particle indices */
+    int *ring_start, *ring;    /* each particle's neighbours along edges */
+    cs_bvh ptree, etree, ttree;
+    cs_box *pbox, *ebox, *tbox;
+    unsigned char *pdirty, *edirty, *tdirty, *vdirty;
+    double *x_free;            /* the last collision-free positions */
+    double *x_before;          /* positions when step C began */
+    double *inv_mass;          /* 0 for pinned and scripted particles */
+    double proximity;          /* delta: closer than this at a coplanar time collides */
+    cs_pair_list pt, ee;       /* repulsion pairs from step A */
+    cs_pair_list cpt, cee;     /* step C candidates of one pass */
+    int *zone;                 /* union-find parent per particle, -1 outside zones */
+    int *zone_list;            /* scratch */
+    cs_selfcol_stats stats;
+    size_t bytes;
+} cs_selfcol;
+
+cs_selfcol *cs_selfcol_create(const cs_sim *sim);
+void cs_selfcol_destroy(cs_selfcol *sc);
+
+/* Step A: pairs near each other in the collision-free state (sim->x, which
+ * equals x_free here) allowing for motion over the coming time span. */
+void cs_selfcol_find_pairs(cs_sim *sim, double span);
+
+/* B.2 (elastic true): inelastic then elastic repulsion on v~^(n+1/2) with
+ * positions x^n. B.8 (elastic false): inelastic repulsion and friction on
+ * v^(n+1) with positions x^(n+1). */
+void cs_selfcol_repulse(cs_sim *sim, const double *x, double *v, double dt, bool elastic);
+
+/* Step C over the span since the last collision-free state, k time steps
+ * of it. Updates x, v and the collision-free state. With detect_only,
+ * returns the number of colliding pairs of the first pass and changes
+ * nothing (the rewind scheme's test). */
+long cs_selfcol_collide(cs_sim *sim, double span, int k, bool detect_only);
+
+/* Rigid motion of an impact zone (exposed for tests): from free positions
+ * xf and effective velocities u of particles idx[0..n), with masses m,
+ * linear velocity vcm and angular velocity omega conserving the zone's
+ * linear and angular momentum (the inertia tensor pseudo-inverted through
+ * its eigen decomposition, so coplanar, colinear and coincident points
+ * work); writes x = xcm + span vcm + R(omega span)(xf - xcm). */
+void cs_impact_zone_motion(int n, const int *idx, const double *m, const double *xf,
+                           const double *u, double span, double *x, double vcm[3],
+                           double omega[3]);
+
+#endif
