@@ -41,7 +41,7 @@
 static const double default_cloth_color[3] = {0.8, 0.3, 0.2};
 static const double default_body_color[3] = {0.7, 0.7, 0.7};
 
-static const char *const shape_names[] = {"plane", "sphere", "box", "cylinder"};
+static const char *const shape_names[] = {"plane", "sphere", "box", "cylinder", "mesh"};
 
 typedef struct loader {
     const char *file;            /* the name messages use */
@@ -506,6 +506,63 @@ static char *dup_str(const char *s)
 static const double zero3[3] = {0, 0, 0};
 static const double identity_quat[4] = {1, 0, 0, 0};
 
+/* A line for the user (see cs_scene.notes); false when memory runs out. */
+static bool add_note(cs_scene *s, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
+
+static bool add_note(cs_scene *s, const char *fmt, ...)
+{
+    char line[1024];
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(line, sizeof line, fmt, ap);
+    va_end(ap);
+    char **notes = realloc(s->notes, ((size_t)s->nnotes + 1) * sizeof *notes);
+    if (!notes)
+        return false;
+    s->notes = notes;
+    if (!(notes[s->nnotes] = dup_str(line)))
+        return false;
+    s->nnotes++;
+    return true;
+}
+
+/* The folder of the scene file, to which its paths are relative. */
+static char *scene_dir(const char *file)
+{
+    const char *slash = file ? strrchr(file, '/') : NULL;
+    if (!file || file[0] == '<' || !slash)
+        return dup_str(".");
+    size_t n = slash == file ? 1 : (size_t)(slash - file);
+    char *d = malloc(n + 1);
+    if (d) {
+        memcpy(d, file, n);
+        d[n] = '\0';
+    }
+    return d;
+}
+
+/* path relative to the scene's folder, unless absolute */
+static char *scene_relative(const char *file, const char *path)
+{
+    if (path[0] == '/')
+        return dup_str(path);
+    char *dir = scene_dir(file);
+    if (!dir)
+        return NULL;
+    size_t n = strlen(dir) + strlen(path) + 2;
+    char *out = malloc(n);
+    if (out)
+        snprintf(out, n, "%s/%s", dir, path);
+    free(dir);
+    return out;
+}
+
+static const char *base_name(const char *path)
+{
+    const char *slash = strrchr(path, '/');
+    return slash ? slash + 1 : path;
+}
+
 /* ------------------------------------------------------------- motions */
 
 /* A motion of a frame whose initial pose is (pos, rot). */
@@ -774,49 +831,190 @@ static int convert_grid(loader *L, const cs_raw_grid *g, const char *base, int r
     return *mesh ? CS_IMPORT_OK : CS_IMPORT_NOMEM;
 }
 
-static int convert_mesh(loader *L, const cs_raw_mesh *m, const char *base, cs_trimesh **mesh)
+/* mesh.scale: one number (uniform) or three, each > 0. Read from the
+ * document: the schema cannot say "a number or a list". */
+static int read_scale(loader *L, const char *path, double out[3])
+{
+    static const char *want = "expected a number > 0 or a list of 3 numbers > 0";
+    cs_spath p;
+    cs_sloc loc;
+    out[0] = out[1] = out[2] = 1;
+    if (!cs_spath_parse(&p, path))
+        return CS_IMPORT_OK;
+    cs_sdoc_locate(&L->doc, &p, false, &loc);
+    if (loc.matched != p.n || !loc.node)
+        return CS_IMPORT_OK;
+    const yaml_node_t *n = yaml_document_get_node(&L->doc.doc, loc.node);
+    if (!n)
+        return CS_IMPORT_OK;
+    int items = 1;
+    const yaml_node_item_t *item = NULL;
+    if (n->type == YAML_SEQUENCE_NODE) {
+        item = n->data.sequence.items.start;
+        items = (int)(n->data.sequence.items.top - item);
+        if (items != 3)
+            return fail(L, path, false, "%s (got a list of %d)", want, items);
+    } else if (n->type != YAML_SCALAR_NODE) {
+        return fail(L, path, true, "%s", want);
+    }
+    for (int k = 0; k < items; k++) {
+        const yaml_node_t *e = item ? yaml_document_get_node(&L->doc.doc, item[k]) : n;
+        char ep[PATH_LEN + 8];
+        snprintf(ep, sizeof ep, item ? "%s[%d]" : "%s", path, k);
+        if (!e || e->type != YAML_SCALAR_NODE)
+            return fail(L, ep, true, "%s", item ? "expected a number > 0" : want);
+        const char *text = (const char *)e->data.scalar.value;
+        char *end;
+        double v = strtod(text, &end);
+        if (!*text || isspace((unsigned char)*text) || *end || !isfinite(v))
+            return fail(L, ep, true, "%s", item ? "expected a number > 0" : want);
+        if (!(v > 0))
+            return fail(L, ep, true, "must be > 0");
+        for (int d = item ? k : 0; d < (item ? k + 1 : 3); d++)
+            out[d] = v;
+    }
+    return CS_IMPORT_OK;
+}
+
+/* The placement keys of a mesh block. */
+static int convert_placement(loader *L, const cs_raw_mesh *m, const char *mp,
+                             cs_mesh_placement *pl)
 {
     char p[PATH_LEN];
-    double deg[3], t[3], q[4];
+    double deg[3];
     int rc;
-    int nv = (int)m->vertices_count, nt = (int)m->triangles_count;
-    if (m->vertices_count > INT_MAX / 3 || m->triangles_count > INT_MAX / 3) {
-        snprintf(p, sizeof p, "%s.mesh", base);
-        return fail(L, p, false, "is too large");
+    *pl = cs_default_mesh_placement();
+    snprintf(p, sizeof p, "%s.scale", mp);
+    if ((rc = read_scale(L, p, pl->scale)))
+        return rc;
+    snprintf(p, sizeof p, "%s.rotation", mp);
+    if ((rc = vec(L, m->rotation, 3, zero3, ANY, p, deg)))
+        return rc;
+    cs_quat_from_euler_degrees(deg, pl->rotation);
+    snprintf(p, sizeof p, "%s.translate", mp);
+    return vec(L, m->translate, 3, zero3, ANY, p, pl->translate);
+}
+
+/* A mesh file through assimp; *file gets the path as opened. */
+static int convert_mesh_file(loader *L, const cs_raw_mesh *m, const char *mp, cs_trimesh **mesh,
+                             cs_mesh_report *rep, char **file)
+{
+    char p[PATH_LEN + 32], why[768];
+    cs_mesh_placement pl;
+    int rc;
+    if (m->triangles) {
+        snprintf(p, sizeof p, "%s.triangles", mp);
+        return fail(L, p, false, "is only used with vertices (remove it or the file)");
     }
+    if ((rc = convert_placement(L, m, mp, &pl)))
+        return rc;
+    pl.node = m->node;
+    if (m->units && *m->units > 0 &&
+        !cs_mesh_units_from_name(cs_scene_unit_names[*m->units], &pl.unit_scale))
+        pl.unit_scale = 0;
+    snprintf(p, sizeof p, "%s.file", mp);
+    if (!*m->file)
+        return fail(L, p, false, "must not be empty");
+    if (!(*file = scene_relative(L->file, m->file)))
+        return CS_IMPORT_NOMEM;
+    rc = cs_mesh_import(*file, &pl, mesh, rep, why, sizeof why);
+    if (rc == CS_IMPORT_BAD_INPUT) {
+        /* a node that is not there is the node key's fault */
+        if (m->node && rep->format[0] && rep->instances == 0)
+            snprintf(p, sizeof p, "%s.node", mp);
+        return fail(L, p, false, "%s", why);
+    }
+    return rc;
+}
+
+static int convert_mesh(loader *L, const cs_raw_mesh *m, const char *base, cs_trimesh **mesh,
+                        cs_mesh_report *rep, char **file)
+{
+    char p[PATH_LEN + 64], mp[PATH_LEN];
+    int rc;
+    snprintf(mp, sizeof mp, "%s.mesh", base);
+    memset(rep, 0, sizeof *rep);
+    *file = NULL;
+    if (!m->file == !m->vertices)
+        return fail(L, mp, false, "expected exactly one of file or vertices (got %s)",
+                    m->file ? "both" : "neither");
+    if (m->file)
+        return convert_mesh_file(L, m, mp, mesh, rep, file);
+    if (m->node || m->units) {
+        snprintf(p, sizeof p, "%s.%s", mp, m->node ? "node" : "units");
+        return fail(L, p, false, "is only used with file (remove it)");
+    }
+    int nv = (int)m->vertices_count, nt = (int)m->triangles_count;
+    if (m->vertices_count > INT_MAX / 3 || m->triangles_count > INT_MAX / 3)
+        return fail(L, mp, false, "is too large");
     for (int f = 0; f < nt; f++) {
         const int *c = m->triangles[f];
         for (int k = 0; k < 3; k++)
             if (c[k] < 0 || c[k] >= nv) {
-                snprintf(p, sizeof p, "%s.mesh.triangles[%d][%d]", base, f, k);
+                snprintf(p, sizeof p, "%s.triangles[%d][%d]", mp, f, k);
                 return fail(L, p, true, "must be a vertex index in [0, %d]", nv - 1);
             }
         if (c[0] == c[1] || c[1] == c[2] || c[0] == c[2]) {
-            snprintf(p, sizeof p, "%s.mesh.triangles[%d]", base, f);
+            snprintf(p, sizeof p, "%s.triangles[%d]", mp, f);
             return fail(L, p, false, "must name three distinct vertices (got [%d, %d, %d])", c[0],
                         c[1], c[2]);
         }
     }
-    snprintf(p, sizeof p, "%s.mesh.rotation", base);
-    if ((rc = vec(L, m->rotation, 3, zero3, ANY, p, deg)))
+    cs_mesh_placement pl;
+    if ((rc = convert_placement(L, m, mp, &pl)))
         return rc;
-    snprintf(p, sizeof p, "%s.mesh.translate", base);
-    if ((rc = vec(L, m->translate, 3, zero3, ANY, p, t)))
-        return rc;
-    cs_quat_from_euler_degrees(deg, q);
     *mesh = cs_trimesh_create(nv, nt);
     if (!*mesh)
         return CS_IMPORT_NOMEM;
     for (int v = 0; v < nv; v++) {
-        double r[3];
-        cs_quat_rotate(q, m->vertices[v], r);
+        double sc[3], r[3];
         for (int k = 0; k < 3; k++)
-            (*mesh)->x[3 * v + k] = r[k] + t[k];
+            sc[k] = pl.scale[k] * m->vertices[v][k];
+        cs_quat_rotate(pl.rotation, sc, r);
+        for (int k = 0; k < 3; k++)
+            (*mesh)->x[3 * v + k] = r[k] + pl.translate[k];
     }
     for (int f = 0; f < nt; f++)
         for (int k = 0; k < 3; k++)
             (*mesh)->tri[3 * f + k] = m->triangles[f][k];
+    snprintf(rep->format, sizeof rep->format, "inline");
+    rep->unit_scale = 1;
+    cs_mesh_analyse(*mesh, rep);
     return CS_IMPORT_OK;
+}
+
+/* One line on what import did with a mesh file, and a warning for what the
+ * cloth or body will feel. */
+static bool note_mesh(cs_scene *s, const char *who, const char *file, const cs_mesh_report *r,
+                      bool body)
+{
+    char fixes[256] = "";
+    size_t used = 0;
+    if (r->degenerate_triangles)
+        used += (size_t)snprintf(fixes + used, sizeof fixes - used,
+                                 "; dropped %d zero-area triangle%s", r->degenerate_triangles,
+                                 r->degenerate_triangles == 1 ? "" : "s");
+    if (r->duplicate_triangles && used < sizeof fixes)
+        used += (size_t)snprintf(fixes + used, sizeof fixes - used,
+                                 "; dropped %d duplicate triangle%s", r->duplicate_triangles,
+                                 r->duplicate_triangles == 1 ? "" : "s");
+    if (r->unreferenced_vertices && used < sizeof fixes)
+        snprintf(fixes + used, sizeof fixes - used, "; dropped %d unused vertices",
+                 r->unreferenced_vertices);
+    if (!add_note(s, "%s: %s (%s, %s): %d triangles, %d vertices, %d part%s, %s%s", who,
+                  base_name(file), r->format, r->units, r->triangles, r->vertices, r->parts,
+                  r->parts == 1 ? "" : "s", r->closed ? "closed" : "open", fixes))
+        return false;
+    if (r->nonmanifold_edges &&
+        !add_note(s, "warning: %s: %d non-manifold edge%s (more than two triangles on an edge)%s",
+                  who, r->nonmanifold_edges, r->nonmanifold_edges == 1 ? "" : "s",
+                  body ? "" : "; bending springs join every pair of triangles across them"))
+        return false;
+    if (r->inconsistent_edges &&
+        !add_note(s, "warning: %s: %d edge%s where neighbouring triangles disagree on "
+                  "orientation", who, r->inconsistent_edges, r->inconsistent_edges == 1 ? "" : "s"))
+        return false;
+    return true;
 }
 
 static int convert_material(loader *L, const cs_raw_material *m, const char *base,
@@ -876,9 +1074,18 @@ static int convert_cloth(loader *L, const cs_raw_cloth *rc, int ci, cs_scene *s)
     if (!rc->grid == !rc->mesh)
         return fail(L, base, false, "expected exactly one of grid or mesh (got %s)",
                     rc->grid ? "both" : "neither");
+    cs_mesh_report report;
+    char *file = NULL;
     err = rc->grid ? convert_grid(L, rc->grid, base, res, &mesh)
-                   : convert_mesh(L, rc->mesh, base, &mesh);
+                   : convert_mesh(L, rc->mesh, base, &mesh, &report, &file);
     cd->mesh = mesh;
+    if (!err && file) {
+        char who[128];
+        snprintf(who, sizeof who, "%s '%.60s'", base, cd->name);
+        if (!note_mesh(s, who, file, &report, false))
+            err = CS_IMPORT_NOMEM;
+    }
+    free(file);
     if (err)
         return err;
 
@@ -909,6 +1116,152 @@ static int required(loader *L, const void *given, const char *base, const char *
         return CS_IMPORT_OK;
     snprintf(p, sizeof p, "%s.%s", base, key);
     return fail(L, p, false, "is required for a %s", shape_names[shape]);
+}
+
+#define DEFAULT_BAND 3.0
+
+/* The mesh of a mesh body, in the body's local frame, and its grid
+ * settings; the grid itself is made once the whole scene is known
+ * (finish_mesh_bodies, build_levelsets). */
+static int convert_mesh_body(loader *L, const cs_raw_body *rb, int bi, cs_scene *s)
+{
+    cs_scene_mesh_body *mb = &s->mesh_bodies[bi];
+    char base[48], p[PATH_LEN];
+    int err;
+    snprintf(base, sizeof base, "bodies[%d]", bi);
+    if ((err = convert_mesh(L, rb->mesh, base, &mb->mesh, &mb->report, &mb->file)))
+        return err;
+    if (!mb->file && !(mb->file = dup_str("(inline)")))
+        return CS_IMPORT_NOMEM;
+    if (mb->mesh->nt == 0) {
+        snprintf(p, sizeof p, "%s.mesh", base);
+        return fail(L, p, false, "must have triangles for a body");
+    }
+    static const range at_least_one = {GE, 1, NONE, 0};
+    snprintf(p, sizeof p, "%s.voxel_size", base);
+    if ((err = num(L, rb->voxel_size, 0, POSITIVE, p, &mb->voxel_size)))
+        return err;
+    snprintf(p, sizeof p, "%s.band", base);
+    if ((err = num(L, rb->band, DEFAULT_BAND, at_least_one, p, &mb->band)))
+        return err;
+    mb->close_holes = rb->close_holes ? *rb->close_holes : true;
+    mb->interior = rb->interior ? (cs_interior_mode)*rb->interior : CS_INTERIOR_AUTO;
+    return CS_IMPORT_OK;
+}
+
+/* The median edge length over all cloths: what the default voxel size
+ * follows (0 if there are no edges). */
+static double cloth_edge_median(const cs_sim_def *d)
+{
+    long total = 0;
+    for (int c = 0; c < d->ncloths; c++)
+        total += d->cloths[c].mesh ? 3L * d->cloths[c].mesh->nt : 0;
+    if (total == 0)
+        return 0;
+    long stride = total / 30000 + 1, n = 0; /* a sample is plenty for a median */
+    double *len = malloc(((size_t)(total / stride) + 2) * sizeof *len);
+    if (!len)
+        return 0;
+    long k = 0;
+    for (int c = 0; c < d->ncloths; c++) {
+        const cs_trimesh *m = d->cloths[c].mesh;
+        for (int t = 0; m && t < m->nt; t++)
+            for (int e = 0; e < 3; e++, k++) {
+                if (k % stride)
+                    continue;
+                const double *a = m->x + 3 * m->tri[3 * t + e];
+                const double *b = m->x + 3 * m->tri[3 * t + (e + 1) % 3];
+                len[n++] = sqrt((a[0] - b[0]) * (a[0] - b[0]) + (a[1] - b[1]) * (a[1] - b[1]) +
+                                (a[2] - b[2]) * (a[2] - b[2]));
+            }
+    }
+    /* selection by sorting: n is at most 30000 */
+    for (long i = 1; i < n; i++) {
+        double v = len[i];
+        long j = i;
+        for (; j > 0 && len[j - 1] > v; j--)
+            len[j] = len[j - 1];
+        len[j] = v;
+    }
+    double median = n ? len[n / 2] : 0;
+    free(len);
+    return median;
+}
+
+/* Voxel sizes (given, or the default from the cloth's edge length), their
+ * check against the mesh and memory, and closing the holes the sign needs
+ * closed: everything about mesh bodies that can fail with a message. */
+static int finish_mesh_bodies(loader *L, cs_scene *s)
+{
+    double edge = -1;
+    for (int b = 0; b < s->def.nbodies; b++) {
+        cs_scene_mesh_body *mb = &s->mesh_bodies[b];
+        if (!mb->mesh)
+            continue;
+        char base[48], p[PATH_LEN], who[128], why[256];
+        snprintf(base, sizeof base, "bodies[%d]", b);
+        snprintf(who, sizeof who, "%s '%.60s'", base, s->def.bodies[b].name);
+        if (strcmp(mb->file, "(inline)") && !note_mesh(s, who, mb->file, &mb->report, true))
+            return CS_IMPORT_NOMEM;
+        cs_trimesh *sign = mb->mesh;
+        cs_mesh_report closed = mb->report;
+        if (!mb->report.closed && mb->close_holes) {
+            /* a copy with the holes closed; mb->mesh stays as read */
+            sign = cs_trimesh_create(mb->mesh->nv, mb->mesh->nt);
+            if (!sign)
+                return CS_IMPORT_NOMEM;
+            memcpy(sign->x, mb->mesh->x, 3 * (size_t)mb->mesh->nv * sizeof *sign->x);
+            memcpy(sign->tri, mb->mesh->tri, 3 * (size_t)mb->mesh->nt * sizeof *sign->tri);
+            mb->holes_closed = cs_mesh_close_holes(&sign);
+            if (mb->holes_closed < 0) {
+                cs_trimesh_destroy(sign);
+                return CS_IMPORT_NOMEM;
+            }
+            cs_mesh_analyse(sign, &closed);
+        }
+        mb->sign_mesh = sign;
+        if (!mb->report.closed) {
+            bool ok;
+            if (!mb->close_holes)
+                ok = add_note(s, "warning: %s: the mesh is not closed (%d boundary edges) and "
+                                 "close_holes is false: the sign comes from OpenVDB's flood fill "
+                                 "from outside, which leaks in through holes wider than about a "
+                                 "voxel",
+                              who, mb->report.boundary_edges);
+            else if (closed.closed)
+                ok = add_note(s, "warning: %s: the mesh is not closed (%d boundary edges in %d "
+                                 "loop%s); closed them with fans to each loop's centre so the "
+                                 "level set has an inside",
+                              who, mb->report.boundary_edges, mb->report.boundary_loops,
+                              mb->report.boundary_loops == 1 ? "" : "s");
+            else
+                ok = add_note(s, "warning: %s: the mesh is not closed and stays open after "
+                                 "closing %d loop%s (%d boundary and %d non-manifold edges "
+                                 "left): the sign may be wrong near them",
+                              who, mb->holes_closed, mb->holes_closed == 1 ? "" : "s",
+                              closed.boundary_edges, closed.nonmanifold_edges);
+            if (!ok)
+                return CS_IMPORT_NOMEM;
+        }
+        bool given = mb->voxel_size > 0;
+        bool fill = mb->interior == CS_INTERIOR_FILL;
+        if (!given) {
+            if (edge < 0)
+                edge = cloth_edge_median(&s->def);
+            mb->voxel_size = cs_levelset_default_voxel(&closed, edge, mb->band, fill);
+        }
+        mb->fill_interior = mb->interior == CS_INTERIOR_AUTO
+                                ? cs_levelset_auto_fill(&closed, mb->voxel_size)
+                                : fill;
+        if (!cs_levelset_voxel_ok(&closed, mb->voxel_size, mb->band, mb->fill_interior, why,
+                                  sizeof why)) {
+            snprintf(p, sizeof p, "%s%s", base, given ? ".voxel_size" : "");
+            if (given)
+                return fail(L, p, true, "%s", why);
+            return fail(L, p, false, "the default voxel_size %.3g m %s", mb->voxel_size, why);
+        }
+    }
+    return CS_IMPORT_OK;
 }
 
 static int convert_body(loader *L, const cs_raw_body *rb, int bi, cs_scene *s)
@@ -965,6 +1318,15 @@ static int convert_body(loader *L, const cs_raw_body *rb, int bi, cs_scene *s)
     if ((err = (radius ? required : unused)(L, rb->radius, base, "radius", shape)) ||
         (err = (size ? required : unused)(L, rb->size, base, "size", shape)) ||
         (err = (height ? required : unused)(L, rb->height, base, "height", shape)))
+        return err;
+    bool mesh = shape == CS_BODY_MESH;
+    if ((err = (mesh ? required : unused)(L, rb->mesh, base, "mesh", shape)) ||
+        (err = unused(L, mesh ? NULL : rb->voxel_size, base, "voxel_size", shape)) ||
+        (err = unused(L, mesh ? NULL : rb->band, base, "band", shape)) ||
+        (err = unused(L, mesh ? NULL : rb->close_holes, base, "close_holes", shape)) ||
+        (err = unused(L, mesh ? NULL : rb->interior, base, "interior", shape)))
+        return err;
+    if (mesh && (err = convert_mesh_body(L, rb, bi, s)))
         return err;
     snprintf(p, sizeof p, "%s.radius", base);
     if ((err = num(L, rb->radius, bd->radius, POSITIVE, p, &bd->radius)))
@@ -1166,13 +1528,25 @@ static int convert_scene(loader *L, const cs_raw_scene *r, const char *default_n
     if (r->bodies_count > 0) {
         s->body_colors = calloc(3 * (size_t)r->bodies_count, sizeof *s->body_colors);
         s->def.bodies = calloc(r->bodies_count, sizeof *s->def.bodies);
-        if (!s->body_colors || !s->def.bodies)
+        s->mesh_bodies = calloc(r->bodies_count, sizeof *s->mesh_bodies);
+        if (!s->body_colors || !s->def.bodies || !s->mesh_bodies)
             goto nomem;
         s->def.nbodies = (int)r->bodies_count;
         for (unsigned b = 0; b < r->bodies_count; b++)
             if ((rc = convert_body(L, &r->bodies[b], (int)b, s)))
                 goto fail;
+        if ((rc = finish_mesh_bodies(L, s)))
+            goto fail;
     }
+    if (r->levelset && r->levelset->cache && !*r->levelset->cache) {
+        rc = fail(L, "levelset.cache", false, "must not be empty (none turns the cache off)");
+        goto fail;
+    }
+    char *dir = scene_dir(L->file);
+    if (!dir)
+        goto nomem;
+    s->levelset_cache = cs_levelset_cache_dir(r->levelset ? r->levelset->cache : NULL, dir);
+    free(dir);
     *out = s;
     return CS_IMPORT_OK;
 nomem:
@@ -1203,12 +1577,92 @@ void cs_scene_destroy(cs_scene *s)
         free((void *)s->def.bodies[b].motion.keys);
     }
     free((void *)s->def.bodies);
+    for (int b = 0; s->mesh_bodies && b < s->def.nbodies; b++) {
+        cs_scene_mesh_body *mb = &s->mesh_bodies[b];
+        if (mb->sign_mesh != mb->mesh)
+            cs_trimesh_destroy(mb->sign_mesh);
+        cs_trimesh_destroy(mb->mesh);
+        cs_levelset_destroy(mb->levelset);
+        free(mb->file);
+        free(mb->cache_path);
+    }
+    free(s->mesh_bodies);
+    free(s->levelset_cache);
+    for (int i = 0; i < s->nnotes; i++)
+        free(s->notes[i]);
+    free(s->notes);
     free(s->name);
     free(s->path);
     free(s->output_format);
     free(s->cloth_colors);
     free(s->body_colors);
     free(s);
+}
+
+/* ------------------------------------------------------------ level sets */
+
+/* Makes (or reads from the cache) the grid of every mesh body and plugs it
+ * into the body's phi. Only once the whole scene converted without error,
+ * so nothing is converted for a scene that is then refused. */
+static int build_levelsets(loader *L, cs_scene *s)
+{
+    for (int b = 0; s->mesh_bodies && b < s->def.nbodies; b++) {
+        cs_scene_mesh_body *mb = &s->mesh_bodies[b];
+        if (!mb->mesh)
+            continue;
+        char stem[128], who[128], why[512], p[64];
+        snprintf(stem, sizeof stem, "%s", base_name(mb->file));
+        char *dot = strrchr(stem, '.');
+        if (dot && dot != stem)
+            *dot = '\0';
+        snprintf(who, sizeof who, "bodies[%d] '%.60s'", b, s->def.bodies[b].name);
+        cs_levelset_request req = {
+            .voxel_size = mb->voxel_size,
+            .band = mb->band,
+            .fill_interior = mb->fill_interior,
+            .cache_dir = s->levelset_cache,
+            .label = stem,
+        };
+        cs_levelset_result res;
+        int rc = cs_levelset_build(mb->sign_mesh, &req, &res, why, sizeof why);
+        if (rc != CS_IMPORT_OK) {
+            snprintf(p, sizeof p, "bodies[%d].mesh", b);
+            return rc == CS_IMPORT_NOMEM ? rc
+                                         : fail(L, p, false, "cannot make its level set: %s", why);
+        }
+        mb->levelset = res.grid;
+        mb->from_cache = res.from_cache;
+        mb->seconds = res.seconds;
+        if (res.cache_path[0] && !(mb->cache_path = dup_str(res.cache_path)))
+            return CS_IMPORT_NOMEM;
+        cs_levelset_info info;
+        cs_levelset_get_info(mb->levelset, &info);
+        cs_body_def *bd = (cs_body_def *)&s->def.bodies[b];
+        bd->phi_fn = cs_levelset_phi;
+        bd->phi_data = mb->levelset;
+        bd->phi_bounded = true;
+        memcpy(bd->phi_min, info.min, sizeof info.min);
+        memcpy(bd->phi_max, info.max, sizeof info.max);
+        char done[1200];
+        if (res.from_cache)
+            snprintf(done, sizeof done, "read from the cache %s in %.2f s", res.cache_path,
+                     res.seconds);
+        else if (res.cache_path[0])
+            snprintf(done, sizeof done, "converted in %.2f s, cached as %s", res.seconds,
+                     res.cache_path);
+        else
+            snprintf(done, sizeof done, "converted in %.2f s (not cached)", res.seconds);
+        if (!add_note(s, "%s: level set %dx%dx%d voxels of %.3g m (band %g%s), %lld active, "
+                         "%.1f MB; %s",
+                      who, info.dim[0], info.dim[1], info.dim[2], info.voxel_size, mb->band,
+                      mb->fill_interior ? ", interior filled" : "", info.active_voxels,
+                      info.memory_bytes / 1e6, done))
+            return CS_IMPORT_NOMEM;
+        if (res.cache_note[0] && !add_note(s, "warning: %s: level-set cache: %s", who,
+                                           res.cache_note))
+            return CS_IMPORT_NOMEM;
+    }
+    return CS_IMPORT_OK;
 }
 
 /* --------------------------------------------------------------- loading */
@@ -1323,6 +1777,12 @@ static int load(const char *text, size_t len, const char *file, const char *defa
         rc = convert_scene(L, raw, default_name, out);
         if (rc == CS_IMPORT_BAD_INPUT)
             rc = report(L, false, err, errlen);
+    }
+    if (rc == CS_IMPORT_OK && (rc = build_levelsets(L, *out)) != CS_IMPORT_OK) {
+        if (rc == CS_IMPORT_BAD_INPUT)
+            report(L, L->noverrides > 0, err, errlen);
+        cs_scene_destroy(*out);
+        *out = NULL;
     }
     if (rc == CS_IMPORT_NOMEM)
         set_err(err, errlen, "%s: out of memory", file);

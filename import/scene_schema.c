@@ -7,6 +7,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "import/import.h"
 #include "sim/sim.h"
 
 /* Every optional key: absent leaves the member NULL. */
@@ -50,7 +51,15 @@ static const cyaml_strval_t shape_names[] = {
     {"sphere", CS_BODY_SPHERE},
     {"box", CS_BODY_BOX},
     {"cylinder", CS_BODY_CYLINDER},
+    {"mesh", CS_BODY_MESH},
 };
+
+const char *const cs_scene_unit_names[CS_SCENE_UNIT_COUNT] = {"auto", "m",  "cm", "mm",
+                                                              "km",   "in", "ft"};
+static const cyaml_strval_t interior_names[] = {
+    {"auto", CS_INTERIOR_AUTO}, {"fill", CS_INTERIOR_FILL}, {"band", CS_INTERIOR_BAND}};
+static const cyaml_strval_t unit_names[] = {{"auto", 0}, {"m", 1},  {"cm", 2}, {"mm", 3},
+                                            {"km", 4},   {"in", 5}, {"ft", 6}};
 
 static const cyaml_schema_field_t time_fields[] = {
     NUM("fps", cs_raw_time, fps),
@@ -120,7 +129,12 @@ static const cyaml_schema_field_t grid_fields[] = {
 };
 
 static const cyaml_schema_field_t mesh_fields[] = {
-    CYAML_FIELD_SEQUENCE("vertices", REQ, cs_raw_mesh, vertices, &vec3_value, 1,
+    STR("file", cs_raw_mesh, file),
+    STR("node", cs_raw_mesh, node),
+    CYAML_FIELD_ENUM_PTR("units", OPT | CYAML_FLAG_STRICT, cs_raw_mesh, units, unit_names,
+                         CYAML_ARRAY_LEN(unit_names)),
+    CYAML_FIELD_IGNORE("scale", CYAML_FLAG_OPTIONAL),
+    CYAML_FIELD_SEQUENCE("vertices", OPT, cs_raw_mesh, vertices, &vec3_value, 1,
                          CYAML_UNLIMITED),
     CYAML_FIELD_SEQUENCE("triangles", OPT, cs_raw_mesh, triangles, &int3_value, 0,
                          CYAML_UNLIMITED),
@@ -213,10 +227,21 @@ static const cyaml_schema_field_t body_fields[] = {
     NUM("friction", cs_raw_body, friction),
     VEC("color", OPT, cs_raw_body, color, 3),
     CYAML_FIELD_MAPPING_PTR("motion", OPT, cs_raw_body, motion, motion_fields),
+    CYAML_FIELD_MAPPING_PTR("mesh", OPT, cs_raw_body, mesh, mesh_fields),
+    NUM("voxel_size", cs_raw_body, voxel_size),
+    NUM("band", cs_raw_body, band),
+    BOOL("close_holes", cs_raw_body, close_holes),
+    CYAML_FIELD_ENUM_PTR("interior", OPT | CYAML_FLAG_STRICT, cs_raw_body, interior,
+                         interior_names, CYAML_ARRAY_LEN(interior_names)),
     CYAML_FIELD_END,
 };
 static const cyaml_schema_value_t body_value = {
     CYAML_VALUE_MAPPING(CYAML_FLAG_DEFAULT, cs_raw_body, body_fields),
+};
+
+static const cyaml_schema_field_t levelset_fields[] = {
+    STR("cache", cs_raw_levelset, cache),
+    CYAML_FIELD_END,
 };
 
 static const cyaml_schema_field_t scene_fields[] = {
@@ -231,6 +256,7 @@ static const cyaml_schema_field_t scene_fields[] = {
     CYAML_FIELD_MAPPING_PTR("camera", OPT, cs_raw_scene, camera, camera_fields),
     CYAML_FIELD_SEQUENCE("cloths", REQ, cs_raw_scene, cloths, &cloth_value, 1, CYAML_UNLIMITED),
     CYAML_FIELD_SEQUENCE("bodies", OPT, cs_raw_scene, bodies, &body_value, 0, CYAML_UNLIMITED),
+    CYAML_FIELD_MAPPING_PTR("levelset", OPT, cs_raw_scene, levelset, levelset_fields),
     CYAML_FIELD_END,
 };
 

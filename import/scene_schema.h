@@ -64,6 +64,11 @@ typedef struct cs_raw_grid {
 } cs_raw_grid;
 
 typedef struct cs_raw_mesh {
+    char *file;                /* a mesh file, relative to the scene's folder */
+    char *node;                /* a node or mesh of that file */
+    int *units;                /* index into cs_scene_unit_names */
+    /* scale: a number or 3 numbers, read from the document (cyaml has no
+     * either-or type) */
     double (*vertices)[3];
     unsigned vertices_count;
     int (*triangles)[3];
@@ -138,7 +143,16 @@ typedef struct cs_raw_body {
     double *friction;
     double *color;             /* 3 */
     cs_raw_motion *motion;
+    cs_raw_mesh *mesh;         /* mesh bodies */
+    double *voxel_size;
+    double *band;
+    bool *close_holes;
+    int *interior;             /* cs_interior_mode */
 } cs_raw_body;
+
+typedef struct cs_raw_levelset {
+    char *cache;               /* a folder, or "none" */
+} cs_raw_levelset;
 
 typedef struct cs_raw_scene {
     char *name;
@@ -154,6 +168,7 @@ typedef struct cs_raw_scene {
     unsigned cloths_count;
     cs_raw_body *bodies;
     unsigned bodies_count;
+    cs_raw_levelset *levelset;
 } cs_raw_scene;
 
 /* The top-level schema (a pointer to cs_raw_scene). */
@@ -161,6 +176,10 @@ extern const cyaml_schema_value_t cs_scene_schema;
 
 /* Output format names, indexed by cs_raw_output.format. */
 extern const char *const cs_scene_format_names[];
+
+/* Mesh units, indexed by cs_raw_mesh.units; 0 is "auto". */
+extern const char *const cs_scene_unit_names[];
+#define CS_SCENE_UNIT_COUNT 7
 
 /* A key path: mapping keys and sequence indices, outermost first. Keys
  * longer than the buffer are cut (they then match nothing). */

@@ -9,8 +9,10 @@
  * position along the normal instead and applies Gamma after the solve to the
  * projected velocity, whose normal part is already gone.
  */
+#include <stdlib.h>
 #include <string.h>
 
+#include "sim/body_grid.h"
 #include "sim/internal.h"
 #include "sim/vec3.h"
 
@@ -36,67 +38,175 @@ void cs_gamma(const double v[3], const double N[3], const double vb[3], double m
         out[d] = vn_star * N[d] + vbt[d] + scale * vrel[d];
 }
 
+/* B.4 for particle i and body b; true when i is in contact with b (its
+ * position then changed). Bodies are queried at time n+1, as the paper
+ * prescribes. */
+static bool collide_one(cs_sim *sim, int i, int b, double t1, double dt, bool improved)
+{
+    double *x = sim->x + 3 * i;
+    const double *xn = sim->x_prev + 3 * i;
+    double *vh = sim->v_half + 3 * i;
+    const cs_body_def *body = sim->bodies + b;
+    double N[3], vb[3], vstar[3];
+    double phi1 = cs_body_def_phi(body, t1, x, N);
+    if (!(phi1 < 0))
+        return false;
+    if (improved) {
+        /* crossing point along the step; phi at time n of the point
+         * x^n is phi_{n+1}(x^n) + dt v_BN (the body moved since) */
+        double Nn[3];
+        double phi0 = cs_body_def_phi(body, t1, xn, Nn);
+        cs_body_def_velocity(body, t1, xn, vb);
+        phi0 += dt * cs_dot(vb, N);
+        double theta = phi0 > 0 ? phi0 / (phi0 - phi1) : 0.0;
+        if (theta > 1)
+            theta = 1;
+        double xc[3];
+        for (int d = 0; d < 3; d++)
+            xc[d] = xn[d] + theta * (x[d] - xn[d]);
+        double Nc[3];
+        cs_body_def_phi(body, t1, xc, Nc);
+        memcpy(N, Nc, sizeof N);
+        cs_body_def_velocity(body, t1, xc, vb);
+        cs_gamma(vh, N, vb, body->friction, vstar);
+        memcpy(vh, vstar, sizeof vstar);
+        for (int d = 0; d < 3; d++)
+            x[d] = xc[d] + (1.0 - theta) * dt * vstar[d];
+        /* On curved or turning bodies the linearisation can leave the
+         * point a little inside: finish along the normal there. */
+        double g[3], phi = cs_body_def_phi(body, t1, x, g);
+        if (phi < 0)
+            cs_axpy(-phi, g, x);
+    } else {
+        cs_axpy(-phi1, N, x); /* Fig. 6 left: straight out along N */
+        cs_body_def_velocity(body, t1, x, vb);
+    }
+    cs_gamma(sim->v + 3 * i, N, vb, body->friction, sim->v_star + 3 * i);
+    memcpy(sim->contact_normal + 3 * i, N, sizeof N);
+    sim->contact_body[i] = b;
+    return true;
+}
+
+/* Points pushed out of one body may land in the box of a later one that
+ * did not list them: they are queued for it (rarely more than a few). */
+typedef struct late_queue {
+    int *head;            /* per body, first entry or -1 */
+    int *next, *point;    /* entries */
+    int n, cap;
+    int all_from;         /* bodies from here on see every point (a push
+                             failed for want of memory) */
+} late_queue;
+
+static void late_push(late_queue *q, int b, int i)
+{
+    if (q->n == q->cap) {
+        int cap = q->cap ? 2 * q->cap : 64;
+        int *next = realloc(q->next, (size_t)cap * sizeof *next);
+        if (next)
+            q->next = next;
+        int *point = next ? realloc(q->point, (size_t)cap * sizeof *point) : NULL;
+        if (point)
+            q->point = point;
+        if (!point) {
+            if (b < q->all_from)
+                q->all_from = b;
+            return;
+        }
+        q->cap = cap;
+    }
+    q->point[q->n] = i;
+    q->next[q->n] = q->head[b];
+    q->head[b] = q->n++;
+}
+
+typedef struct collide_ctx {
+    cs_sim *sim;
+    cs_body_grid *g;
+    late_queue q;
+    int *seen;            /* seen[i] == b: i has met body b */
+    double t1, dt;
+    bool improved;
+} collide_ctx;
+
+static void visit(collide_ctx *c, int i, int b)
+{
+    if (c->seen) {
+        if (c->seen[i] == b)
+            return;
+        c->seen[i] = b;
+    }
+    if (!collide_one(c->sim, i, b, c->t1, c->dt, c->improved) || !c->g->ok)
+        return;
+    const double *x = c->sim->x + 3 * i;
+    int first, last;
+    cs_body_grid_cell_bodies(c->g, x, &first, &last);
+    for (int j = first; j < last; j++) {
+        int later = c->g->cell_bodies[j];
+        if (later > b && cs_body_grid_inside(c->g, later, x))
+            late_push(&c->q, later, i);
+    }
+}
+
 /* Step B.4: sim->x holds x~^(n+1) on entry and x^(n+1) on return; x_prev
  * is x^n, v_half is v~^(n+1/2). Sets v_star = Gamma(v^n) for particles in
- * contact (v^n elsewhere) and marks them CS_CONTACT with their normal. All
- * level set queries use the bodies at time n+1, as the paper prescribes. */
+ * contact (v^n elsewhere) and marks them CS_CONTACT with their normal.
+ *
+ * Each body is visited once, with the free points inside its box at n+1
+ * (body_grid.c); unbounded bodies see every free point. A point meets its
+ * bodies in ascending order, each seeing the position the previous ones
+ * left, exactly as a loop over all bodies per point would: a body it does
+ * not meet has phi >= 0 there. The partition lives for one step only (it
+ * depends on the bodies' pose and the points), so the simulation keeps no
+ * state for it. */
 void cs_body_collide(cs_sim *sim, double dt)
 {
-    double t1 = sim->t + dt;
-    bool improved = sim->def.friction_method == CS_FRICTION_IMPROVED;
-    memcpy(sim->v_star, sim->v, sizeof *sim->v * 3 * (size_t)sim->n);
-    for (int i = 0; i < sim->n; i++) {
+    int n = sim->n, nb = sim->nbodies;
+    memcpy(sim->v_star, sim->v, sizeof *sim->v * 3 * (size_t)n);
+    for (int i = 0; i < n; i++)
         sim->contact_body[i] = -1;
-        if (!sim->is_free[i])
-            continue;
-        double *x = sim->x + 3 * i;
-        const double *xn = sim->x_prev + 3 * i;
-        double *vh = sim->v_half + 3 * i;
-        for (int b = 0; b < sim->nbodies; b++) {
-            const cs_body_def *body = sim->bodies + b;
-            double N[3], vb[3], vstar[3];
-            double phi1 = cs_body_def_phi(body, t1, x, N);
-            if (!(phi1 < 0))
-                continue;
-            if (improved) {
-                /* crossing point along the step; phi at time n of the point
-                 * x^n is phi_{n+1}(x^n) + dt v_BN (the body moved since) */
-                double Nn[3];
-                double phi0 = cs_body_def_phi(body, t1, xn, Nn);
-                cs_body_def_velocity(body, t1, xn, vb);
-                phi0 += dt * cs_dot(vb, N);
-                double theta = phi0 > 0 ? phi0 / (phi0 - phi1) : 0.0;
-                if (theta > 1)
-                    theta = 1;
-                double xc[3];
-                for (int d = 0; d < 3; d++)
-                    xc[d] = xn[d] + theta * (x[d] - xn[d]);
-                double Nc[3];
-                cs_body_def_phi(body, t1, xc, Nc);
-                memcpy(N, Nc, sizeof N);
-                cs_body_def_velocity(body, t1, xc, vb);
-                cs_gamma(vh, N, vb, body->friction, vstar);
-                memcpy(vh, vstar, sizeof vstar);
-                for (int d = 0; d < 3; d++)
-                    x[d] = xc[d] + (1.0 - theta) * dt * vstar[d];
-                /* On curved or turning bodies the linearisation can leave the
-                 * point a little inside: finish along the normal there. */
-                double g[3], phi = cs_body_def_phi(body, t1, x, g);
-                if (phi < 0)
-                    cs_axpy(-phi, g, x);
-            } else {
-                cs_axpy(-phi1, N, x); /* Fig. 6 left: straight out along N */
-                cs_body_def_velocity(body, t1, x, vb);
-            }
-            cs_gamma(sim->v + 3 * i, N, vb, body->friction, sim->v_star + 3 * i);
-            memcpy(sim->contact_normal + 3 * i, N, sizeof N);
-            sim->contact_body[i] = b;
+
+    cs_body_grid g;
+    cs_body_grid_build(&g, sim->bodies, nb, sim->t + dt, sim->x, sim->is_free, n);
+    collide_ctx c = {.sim = sim, .g = &g, .t1 = sim->t + dt, .dt = dt,
+                     .improved = sim->def.friction_method == CS_FRICTION_IMPROVED};
+    c.q.all_from = nb;
+    if (g.ok) {
+        c.q.head = malloc(((size_t)nb + 1) * sizeof *c.q.head);
+        c.seen = malloc(((size_t)n + 1) * sizeof *c.seen);
+        if (!c.q.head || !c.seen) { /* no memory: every body sees every point */
+            free(c.q.head);
+            free(c.seen);
+            c.q.head = c.seen = NULL;
+            cs_body_grid_free(&g);
         }
+        for (int b = 0; g.ok && b < nb; b++)
+            c.q.head[b] = -1;
+        for (int i = 0; g.ok && i < n; i++)
+            c.seen[i] = -1;
+    }
+    for (int b = 0; b < nb; b++) {
+        if (!g.ok || !g.bounded[b] || b >= c.q.all_from) {
+            for (int i = 0; i < n; i++)
+                if (sim->is_free[i])
+                    visit(&c, i, b);
+            continue;
+        }
+        /* the points listed for b, then those queued for it since */
+        for (int k = g.start[b]; k < g.start[b + 1]; k++)
+            visit(&c, g.points[k], b);
+        for (int e = c.q.head[b]; e >= 0; e = c.q.next[e])
+            visit(&c, c.q.point[e], b);
+    }
+    for (int i = 0; i < n; i++)
         if (sim->contact_body[i] >= 0) {
             sim->mode[i] = CS_CONTACT;
             sim->contacts++;
         }
-    }
+    free(c.q.head);
+    free(c.q.next);
+    free(c.q.point);
+    free(c.seen);
+    cs_body_grid_free(&g);
 }
 
 /* Step B.7: v_next holds v~^(n+1) (from v_NP for the improved method);
@@ -114,4 +224,27 @@ void cs_body_friction(cs_sim *sim, double dt)
                  sim->bodies[b].friction, out);
         memcpy(sim->v_next + 3 * i, out, sizeof out);
     }
+}
+
+double cs_sim_body_penetration(const cs_sim *sim)
+{
+    if (!cs_plan_has(&sim->plan, CS_STAGE_BODY_COLLISION))
+        return 0;
+    cs_body_grid g;
+    cs_body_grid_build(&g, sim->bodies, sim->nbodies, sim->t, sim->x, sim->is_free, sim->n);
+    double deepest = 0;
+    for (int b = 0; b < sim->nbodies; b++) {
+        bool listed = g.ok && g.bounded[b];
+        int count = listed ? g.start[b + 1] - g.start[b] : sim->n;
+        for (int k = 0; k < count; k++) {
+            int i = listed ? g.points[g.start[b] + k] : k;
+            if (!sim->is_free[i])
+                continue;
+            double grad[3], phi = cs_body_def_phi(sim->bodies + b, sim->t, sim->x + 3 * i, grad);
+            if (-phi > deepest)
+                deepest = -phi;
+        }
+    }
+    cs_body_grid_free(&g);
+    return deepest;
 }

@@ -498,7 +498,7 @@ static void test_error_wrong_type(void **state)
                             "projection (got best)");
     expect_error_after_grid("bodies:\n  - shape: cone\n",
                             "scenes/a.yaml:4: bodies[0].shape: expected one of plane, sphere, "
-                            "box, cylinder (got cone)");
+                            "box, cylinder, mesh (got cone)");
     expect_error_after_grid("output: {format: png}\n",
                             "scenes/a.yaml:3: output.format: expected one of ply, obj, glb "
                             "(got png)");
