@@ -6,3 +6,4 @@ scripts/install-deps.sh
 cmake -S . -B build -DCMAKE_BUILD_TYPE=Release >/dev/null
 cmake --build build -j"$(nproc)"
 build/bench_accuracy_time gallery
+gallery/render.sh build
