@@ -66,7 +66,8 @@ bool cs_mesh_units_from_name(const char *name, double *metres)
 
 /* Opens with assimp; on failure says why, the system's reason first
  * (assimp only says "Unable to open file"). */
-static const struct aiScene *open_scene(const char *path, char *err, size_t errlen)
+static const struct aiScene *open_scene(const char *path, unsigned flags, char *err,
+                                        size_t errlen)
 {
     if (!path || !*path) {
         set_err(err, errlen, "no mesh file given");
@@ -86,9 +87,7 @@ static const struct aiScene *open_scene(const char *path, char *err, size_t errl
         return NULL;
     }
     fclose(f);
-    /* Only triangulation: joining is done here by position, after the NaN
-     * check, and degenerate triangles are counted here. */
-    const struct aiScene *scene = aiImportFile(path, aiProcess_Triangulate);
+    const struct aiScene *scene = aiImportFile(path, flags);
     if (!scene) {
         const char *why = aiGetErrorString();
         set_err(err, errlen, "cannot read %s: %s", path,
@@ -759,40 +758,26 @@ static void place_point(const cs_mesh_placement *p, double unit, const double in
         out[k] = r[k] + p->translate[k];
 }
 
-int cs_mesh_import(const char *path, const cs_mesh_placement *place, cs_trimesh **out,
-                   cs_mesh_report *report, char *err, size_t errlen)
+/* The read-and-merge phase shared by cs_mesh_import and cs_mesh_read: the
+ * selected meshes (node NULL: all) of an opened scene, node transforms
+ * applied, in file units, vertex order as the file has it; the walk's
+ * counters in stats. */
+static int read_merged(const struct aiScene *scene, const char *path, const char *node,
+                       double **x_out, long *nv_out, int **tri_out, long *nt_out,
+                       int *file_nodes, walk_state *stats, char *err, size_t errlen)
 {
-    cs_mesh_report scratch;
-    cs_mesh_report *r = report ? report : &scratch;
-    cs_mesh_placement def = cs_default_mesh_placement();
-    const cs_mesh_placement *p = place ? place : &def;
-    memset(r, 0, sizeof *r);
-    *out = NULL;
-
-    const struct aiScene *scene = open_scene(path, err, errlen);
-    if (!scene)
-        return CS_IMPORT_BAD_INPUT;
-    format_name(scene, path, r->format, sizeof r->format);
-    r->file_meshes = (int)scene->mNumMeshes;
-    double unit = file_units(scene, r->format, r->units, sizeof r->units);
-    if (p->unit_scale > 0) {
-        unit = p->unit_scale;
-        snprintf(r->units, sizeof r->units, "%g m per unit (as the scene says)", unit);
-    }
-    r->unit_scale = unit;
-
     static const double identity[16] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
-    walk_state st = {.scene = scene, .node = p->node, .bad_vertex = -1};
-    walk(&st, scene->mRootNode, identity, p->node == NULL, 0);
-    r->file_nodes = st.nodes;
+    walk_state st = {.scene = scene, .node = node, .bad_vertex = -1};
+    walk(&st, scene->mRootNode, identity, node == NULL, 0);
+    *file_nodes = st.nodes;
     int rc = CS_IMPORT_BAD_INPUT;
     double *x = NULL;
     int *tri = NULL;
     if (st.too_deep) {
         set_err(err, errlen, "cannot read %s: node tree deeper than 256 levels", path);
-        goto done;
+        goto fail;
     }
-    if (p->node && st.instances == 0) {
+    if (node && st.instances == 0) {
         char names[256] = "";
         int count = 0;
         list_names(scene->mRootNode, names, sizeof names, &count, 0);
@@ -805,32 +790,109 @@ int cs_mesh_import(const char *path, const cs_mesh_placement *place, cs_trimesh 
             }
         }
         set_err(err, errlen, "%s has no node or mesh named '%s' with triangles (it has: %s)",
-                path, p->node, count ? names : "no named nodes");
-        goto done;
+                path, node, count ? names : "no named nodes");
+        goto fail;
     }
     if (st.nt == 0) {
         set_err(err, errlen, "%s holds no triangles%s", path,
                 st.skipped ? " (only points or lines)"
                            : " (is it empty or truncated, or only points or lines?)");
-        goto done;
+        goto fail;
     }
     if (st.nv > INT32_MAX / 3 || st.nt > INT32_MAX / 3) {
         set_err(err, errlen, "%s is too large (%ld vertices, %ld triangles)", path, st.nv, st.nt);
-        goto done;
+        goto fail;
     }
     x = malloc(3 * (size_t)st.nv * sizeof *x);
     tri = malloc(3 * (size_t)st.nt * sizeof *tri);
     if (!x || !tri) {
         set_err(err, errlen, "%s: out of memory for %ld vertices", path, st.nv);
         rc = CS_IMPORT_NOMEM;
-        goto done;
+        goto fail;
     }
     long nv = st.nv, nt = st.nt;
     st.x = x;
     st.tri = tri;
     st.nv = st.nt = st.skipped = st.instances = 0;
     st.nodes = 0;
-    walk(&st, scene->mRootNode, identity, p->node == NULL, 0);
+    walk(&st, scene->mRootNode, identity, node == NULL, 0);
+    *stats = st;
+    *x_out = x;
+    *tri_out = tri;
+    *nv_out = nv;
+    *nt_out = nt;
+    return CS_IMPORT_OK;
+fail:
+    free(x);
+    free(tri);
+    return rc;
+}
+
+cs_trimesh *cs_mesh_read(const char *path, char *err, size_t errlen)
+{
+    /* assimp joins identical vertices (an OBJ lists them per corner) but
+     * nothing is repaired or reordered: frames read back as written */
+    const struct aiScene *scene =
+        open_scene(path, aiProcess_Triangulate | aiProcess_JoinIdenticalVertices, err, errlen);
+    if (!scene)
+        return NULL;
+    double *x = NULL;
+    int *tri = NULL;
+    long nv = 0, nt = 0;
+    int nodes;
+    walk_state st;
+    cs_trimesh *m = NULL;
+    if (read_merged(scene, path, NULL, &x, &nv, &tri, &nt, &nodes, &st, err, errlen) ==
+        CS_IMPORT_OK) {
+        if (st.bad_vertex >= 0)
+            set_err(err, errlen, "%s: vertex %d has a non-finite coordinate", path,
+                    st.bad_vertex);
+        else if (!(m = cs_trimesh_create((int)nv, (int)nt)))
+            set_err(err, errlen, "%s: out of memory", path);
+        else {
+            memcpy(m->x, x, sizeof *x * 3 * (size_t)nv);
+            memcpy(m->tri, tri, sizeof *tri * 3 * (size_t)nt);
+        }
+    }
+    free(x);
+    free(tri);
+    aiReleaseImport(scene);
+    return m;
+}
+
+int cs_mesh_import(const char *path, const cs_mesh_placement *place, cs_trimesh **out,
+                   cs_mesh_report *report, char *err, size_t errlen)
+{
+    cs_mesh_report scratch;
+    cs_mesh_report *r = report ? report : &scratch;
+    cs_mesh_placement def = cs_default_mesh_placement();
+    const cs_mesh_placement *p = place ? place : &def;
+    memset(r, 0, sizeof *r);
+    *out = NULL;
+
+    /* Only triangulation: joining is done by position below, after the NaN
+     * check, and degenerate triangles are counted. */
+    const struct aiScene *scene = open_scene(path, aiProcess_Triangulate, err, errlen);
+    if (!scene)
+        return CS_IMPORT_BAD_INPUT;
+    format_name(scene, path, r->format, sizeof r->format);
+    r->file_meshes = (int)scene->mNumMeshes;
+    double unit = file_units(scene, r->format, r->units, sizeof r->units);
+    if (p->unit_scale > 0) {
+        unit = p->unit_scale;
+        snprintf(r->units, sizeof r->units, "%g m per unit (as the scene says)", unit);
+    }
+    r->unit_scale = unit;
+
+    double *x = NULL;
+    int *tri = NULL;
+    long nv = 0, nt = 0;
+    walk_state st;
+    int rc = read_merged(scene, path, p->node, &x, &nv, &tri, &nt, &r->file_nodes, &st, err,
+                         errlen);
+    if (rc != CS_IMPORT_OK)
+        goto done;
+    rc = CS_IMPORT_BAD_INPUT;
     r->instances = (int)st.instances;
     r->triangles_read = nt;
     r->skipped_primitives = st.skipped;
@@ -915,7 +977,7 @@ static bool fill_nodes(cs_mesh_catalog *c, const struct aiNode *n, int depth, in
 int cs_mesh_catalog_read(const char *path, cs_mesh_catalog **out, char *err, size_t errlen)
 {
     *out = NULL;
-    const struct aiScene *scene = open_scene(path, err, errlen);
+    const struct aiScene *scene = open_scene(path, aiProcess_Triangulate, err, errlen);
     if (!scene)
         return CS_IMPORT_BAD_INPUT;
     cs_mesh_catalog *c = calloc(1, sizeof *c);
