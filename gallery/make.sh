@@ -7,3 +7,4 @@ cmake -S . -B build -DCMAKE_BUILD_TYPE=Release >/dev/null
 cmake --build build -j"$(nproc)"
 build/bench_accuracy_time gallery
 gallery/render.sh build
+gallery/selfcol.sh build
