@@ -12,6 +12,7 @@
  * frame is drawn as one mesh in the first cloth's colour, and the command
  * says so once.
  */
+#include "app/fsutil.h"
 #include "app/render_cmd.h"
 
 #include "app/run.h"
@@ -448,34 +449,6 @@ static int parse_frames(const char *list, int n, int **out, int *count, char *er
 
 /* ------------------------------------------------------------------ utils */
 
-static int make_dirs(const char *path)
-{
-    char *p = strdup(path);
-    if (!p)
-        return -1;
-    int rc = 0;
-    for (char *s = p + 1;; s++) {
-        if (*s == '/' || *s == '\0') {
-            char keep = *s;
-            *s = '\0';
-            struct stat st;
-            if (mkdir(p, 0777) != 0 && errno != EEXIST)
-                rc = -1;
-            else if (stat(p, &st) != 0)
-                rc = -1;
-            else if (!S_ISDIR(st.st_mode)) {
-                errno = ENOTDIR;
-                rc = -1;
-            }
-            *s = keep;
-            if (rc != 0 || keep == '\0')
-                break;
-        }
-    }
-    free(p);
-    return rc;
-}
-
 /* out/<scene name>, the name made safe for a path (as `clothsim run`). */
 static void scene_out_dir(const char *name, char *out, size_t len)
 {
@@ -866,7 +839,7 @@ int cs_render_main(int argc, char **argv)
         status = CS_EXIT_OUTPUT;
         goto done;
     }
-    if (make_dirs(j.out_dir) != 0) {
+    if (cs_make_dirs(j.out_dir) != 0) {
         fprintf(stderr, "clothsim render: cannot create %s: %s\n", j.out_dir, strerror(errno));
         status = CS_EXIT_OUTPUT;
         goto done;

@@ -8,6 +8,7 @@
  * (instability, a signal, a full disk) leaves complete frames and a summary
  * that describes exactly them.
  */
+#include "app/fsutil.h"
 #include "app/run.h"
 
 #include "app/progress.h"
@@ -259,39 +260,6 @@ static void install_signal_handlers(void)
     sigaction(SIGTERM, &sa, NULL);
 }
 
-/* mkdir -p; returns 0 or -1 with errno set. */
-static int make_dirs(const char *path)
-{
-    if (!*path) {
-        errno = ENOENT;
-        return -1;
-    }
-    char *p = strdup(path);
-    if (!p)
-        return -1;
-    int rc = 0;
-    for (char *s = p + 1;; s++) {
-        if (*s == '/' || *s == '\0') {
-            char keep = *s;
-            *s = '\0';
-            struct stat st;
-            if (mkdir(p, 0777) != 0 && errno != EEXIST)
-                rc = -1;
-            else if (stat(p, &st) != 0)
-                rc = -1;
-            else if (!S_ISDIR(st.st_mode)) {
-                errno = ENOTDIR;
-                rc = -1;
-            }
-            *s = keep;
-            if (rc != 0 || keep == '\0')
-                break;
-        }
-    }
-    free(p);
-    return rc;
-}
-
 /* "frame_<digits>.<ply|obj|glb>" with an optional ".tmp". */
 static bool is_frame_file(const char *name)
 {
@@ -473,7 +441,7 @@ static int simulate(run_state *r, const run_options *o)
     cs_summary *s = &r->summary;
     int status = CS_EXIT_OK;
 
-    if (make_dirs(r->frames_dir) != 0) {
+    if (cs_make_dirs(r->frames_dir) != 0) {
         fprintf(stderr, "clothsim: cannot create %s: %s\n", r->frames_dir, strerror(errno));
         return CS_EXIT_OUTPUT;
     }

@@ -1,4 +1,5 @@
 /* scene_render.c: a scene as render/ meshes; see scene_render.h. */
+#include "app/fsutil.h"
 #include "app/scene_render.h"
 
 #include "app/run.h"
@@ -463,34 +464,6 @@ struct cs_run_render {
     int ncloths;
 };
 
-static int make_dirs(const char *path)
-{
-    char *p = strdup(path);
-    if (!p)
-        return -1;
-    int rc = 0;
-    for (char *s = p + 1;; s++) {
-        if (*s == '/' || *s == '\0') {
-            char keep = *s;
-            *s = '\0';
-            struct stat st;
-            if (mkdir(p, 0777) != 0 && errno != EEXIST)
-                rc = -1;
-            else if (stat(p, &st) != 0)
-                rc = -1;
-            else if (!S_ISDIR(st.st_mode)) {
-                errno = ENOTDIR;
-                rc = -1;
-            }
-            *s = keep;
-            if (rc != 0 || keep == '\0')
-                break;
-        }
-    }
-    free(p);
-    return rc;
-}
-
 /* frame_<digits>.png (or .png.tmp): images of an earlier run. */
 static bool is_frame_image(const char *name)
 {
@@ -599,7 +572,7 @@ cs_run_render *cs_run_render_create(const cs_scene *scene, const cs_sim *sim,
         return NULL;
     }
 
-    if (make_dirs(rr->images_dir) != 0) {
+    if (cs_make_dirs(rr->images_dir) != 0) {
         fprintf(stderr, "clothsim: cannot create %s: %s\n", rr->images_dir, strerror(errno));
         *status = CS_EXIT_OUTPUT;
         cs_run_render_destroy(rr);
