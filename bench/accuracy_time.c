@@ -5,13 +5,16 @@
  * the CG tolerance (time.cg_tolerance) and the friction method. Each point
  * is the largest error of the centre of mass against the analytic solution
  * over 1 s, and the median wall time of three runs. Writes a CSV table and
- * a log-log PNG plot (cairo) into the output folder.
+ * a log-log PNG plot (bench/plot.h) into the output folder.
  *
  * usage: bench_accuracy_time [OUT_DIR]      (default: .)
  */
-#include <cairo.h>
+#include <math.h>
+#include <stdio.h>
 #include <stdlib.h>
+#include <string.h>
 
+#include "bench/plot.h"
 #include "tests/incline_analytic.h"
 
 typedef struct point {
@@ -55,114 +58,43 @@ static int measure(const char *series, const char *method, const char *knob, dou
 
 /* --------------------------------------------------------------- plot */
 
-typedef struct axes {
-    double x0, x1, y0, y1;       /* log10 data range */
-    double left, right, top, bottom;
-} axes;
-
-static double px(const axes *a, double v) { return a->left + (log10(v) - a->x0) / (a->x1 - a->x0) * (a->right - a->left); }
-static double py(const axes *a, double v) { return a->bottom - (log10(v) - a->y0) / (a->y1 - a->y0) * (a->bottom - a->top); }
-
-static void plot(const point *p, int n, const char *path)
+/* Error against wall time, log-log; one polyline a series, each point
+ * labelled with its knob's value. The points of a series are consecutive. */
+static int plot(const point *p, int n, const char *path)
 {
-    const int W = 900, H = 600;
-    cairo_surface_t *surf = cairo_image_surface_create(CAIRO_FORMAT_RGB24, W, H);
-    cairo_t *cr = cairo_create(surf);
-    cairo_set_source_rgb(cr, 1, 1, 1);
-    cairo_paint(cr);
-
-    axes a = {1e9, -1e9, 1e9, -1e9, 90, W - 230, 50, H - 70};
+    cs_plot_axis x = {CS_PLOT_LOG, 1e300, 0, 0, "wall time of 1 s simulated (s)", NULL};
+    cs_plot_axis y = {CS_PLOT_LOG, 1e300, 0, 0, "max centre-of-mass error vs analytic (m)", NULL};
+    double xs[MAX_POINTS], ys[MAX_POINTS];
+    char text[MAX_POINTS][32];
+    const char *labels[MAX_POINTS];
     for (int i = 0; i < n; i++) {
-        double e = fmax(p[i].error, 1e-12);
-        a.x0 = fmin(a.x0, floor(log10(p[i].seconds)));
-        a.x1 = fmax(a.x1, ceil(log10(p[i].seconds)));
-        a.y0 = fmin(a.y0, floor(log10(e)));
-        a.y1 = fmax(a.y1, ceil(log10(e)));
+        xs[i] = p[i].seconds;
+        ys[i] = fmax(p[i].error, 1e-12); /* a log axis has no zero */
+        snprintf(text[i], sizeof text[i], "%g", p[i].value);
+        labels[i] = text[i];
+        x.lo = fmin(x.lo, xs[i]), x.hi = fmax(x.hi, xs[i]);
+        y.lo = fmin(y.lo, ys[i]), y.hi = fmax(y.hi, ys[i]);
     }
-    if (a.x1 <= a.x0) a.x1 = a.x0 + 1;
-    if (a.y1 <= a.y0) a.y1 = a.y0 + 1;
-
-    cairo_select_font_face(cr, "sans-serif", CAIRO_FONT_SLANT_NORMAL, CAIRO_FONT_WEIGHT_NORMAL);
-    cairo_set_font_size(cr, 13);
-    cairo_set_line_width(cr, 1);
-    for (int d = (int)a.x0; d <= (int)a.x1; d++) { /* decade grid and labels */
-        double x = px(&a, pow(10, d));
-        cairo_set_source_rgb(cr, 0.85, 0.85, 0.85);
-        cairo_move_to(cr, x, a.top);
-        cairo_line_to(cr, x, a.bottom);
-        cairo_stroke(cr);
-        char lab[16];
-        snprintf(lab, sizeof lab, "1e%d", d);
-        cairo_set_source_rgb(cr, 0, 0, 0);
-        cairo_move_to(cr, x - 14, a.bottom + 18);
-        cairo_show_text(cr, lab);
-    }
-    for (int d = (int)a.y0; d <= (int)a.y1; d++) {
-        double y = py(&a, pow(10, d));
-        cairo_set_source_rgb(cr, 0.85, 0.85, 0.85);
-        cairo_move_to(cr, a.left, y);
-        cairo_line_to(cr, a.right, y);
-        cairo_stroke(cr);
-        char lab[16];
-        snprintf(lab, sizeof lab, "1e%d", d);
-        cairo_set_source_rgb(cr, 0, 0, 0);
-        cairo_move_to(cr, a.left - 45, y + 4);
-        cairo_show_text(cr, lab);
-    }
-    cairo_set_source_rgb(cr, 0, 0, 0);
-    cairo_rectangle(cr, a.left, a.top, a.right - a.left, a.bottom - a.top);
-    cairo_stroke(cr);
-    cairo_move_to(cr, (a.left + a.right) / 2 - 90, H - 25);
-    cairo_show_text(cr, "wall time of 1 s simulated (s)");
-    cairo_save(cr);
-    cairo_move_to(cr, 25, (a.top + a.bottom) / 2 + 120);
-    cairo_rotate(cr, -M_PI / 2);
-    cairo_show_text(cr, "max centre-of-mass error vs analytic (m)");
-    cairo_restore(cr);
-    cairo_set_font_size(cr, 15);
-    cairo_move_to(cr, a.left, 30);
-    cairo_show_text(cr, "Accuracy against time: tetrahedron on the incline (Fig. 8), theta = 36 deg, mu = 0.6");
-
+    cs_plot *pl = cs_plot_create(900, 600);
+    if (!pl)
+        return -1;
+    cs_plot_panel(pl, 90, 50, 900 - 230, 600 - 70, &x, &y,
+                  "Accuracy against time: tetrahedron on the incline (Fig. 8), theta = 36 deg, mu = 0.6");
     const double colors[][3] = {{0.80, 0.20, 0.15}, {0.15, 0.40, 0.80}, {0.30, 0.60, 0.25},
                                 {0.55, 0.30, 0.65}};
-    const char *seen[8];
-    int nseen = 0;
-    for (int i = 0; i < n; i++) {
-        int s = 0;
-        while (s < nseen && strcmp(seen[s], p[i].series) != 0)
-            s++;
-        if (s == nseen)
-            seen[nseen++] = p[i].series;
+    for (int i = 0, s = 0; i < n; s++) {
+        int j = i;
+        while (j < n && strcmp(p[j].series, p[i].series) == 0)
+            j++;
         const double *c = colors[s % 4];
-        cairo_set_source_rgb(cr, c[0], c[1], c[2]);
-        cairo_set_line_width(cr, 2);
-        double x = px(&a, p[i].seconds), y = py(&a, fmax(p[i].error, 1e-12));
-        if (i > 0 && strcmp(p[i - 1].series, p[i].series) == 0) {
-            cairo_move_to(cr, px(&a, p[i - 1].seconds), py(&a, fmax(p[i - 1].error, 1e-12)));
-            cairo_line_to(cr, x, y);
-            cairo_stroke(cr);
-        }
-        cairo_arc(cr, x, y, 4.5, 0, 2 * M_PI);
-        cairo_fill(cr);
-        char lab[32];
-        snprintf(lab, sizeof lab, "%g", p[i].value);
-        cairo_set_font_size(cr, 11);
-        cairo_move_to(cr, x + 6, y - 6);
-        cairo_show_text(cr, lab);
+        cs_plot_style style = {{c[0], c[1], c[2]}, 2, 0, 4.5, 0};
+        cs_plot_series(pl, j - i, xs + i, ys + i, labels + i, &style);
+        cs_plot_legend(pl, p[i].series, &style);
+        i = j;
     }
-    cairo_set_font_size(cr, 13);
-    for (int s = 0; s < nseen; s++) {
-        const double *c = colors[s % 4];
-        cairo_set_source_rgb(cr, c[0], c[1], c[2]);
-        cairo_arc(cr, a.right + 20, a.top + 20 + 22 * s, 4.5, 0, 2 * M_PI);
-        cairo_fill(cr);
-        cairo_set_source_rgb(cr, 0, 0, 0);
-        cairo_move_to(cr, a.right + 30, a.top + 25 + 22 * s);
-        cairo_show_text(cr, seen[s]);
-    }
-    cairo_surface_write_to_png(surf, path);
-    cairo_destroy(cr);
-    cairo_surface_destroy(surf);
+    int rc = cs_plot_write_png(pl, path);
+    cs_plot_destroy(pl);
+    return rc;
 }
 
 int main(int argc, char **argv)
@@ -199,7 +131,10 @@ int main(int argc, char **argv)
     }
     fclose(f);
     snprintf(path, sizeof path, "%s/accuracy_time.png", dir);
-    plot(pts, n, path);
+    if (plot(pts, n, path)) {
+        fprintf(stderr, "bench_accuracy_time: cannot write %s\n", path);
+        return 1;
+    }
     printf("wrote %s/accuracy_time.csv and %s\n", dir, path);
     return 0;
 }
