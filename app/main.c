@@ -3,6 +3,7 @@
  * Only dispatch lives here; each command has its own file (run.c).
  */
 #include "app/run.h"
+#include "sim/sim.h"
 #include "app/mesh_cmds.h"
 #include "app/render_cmd.h"
 #include "app/intersections_cmd.h"
@@ -86,8 +87,12 @@ int main(int argc, char **argv)
         printf("clothsim %s\n", CS_VERSION);
         return CS_EXIT_OK;
     }
-    if (strcmp(cmd, "run") == 0)
-        return cs_run_main(argc - 1, argv + 1);
+    if (strcmp(cmd, "run") == 0) { /* the one command that can span ranks */
+        cs_parallel_init(&argc, &argv);
+        int status = cs_run_main(argc - 1, argv + 1);
+        cs_parallel_finalize();
+        return status;
+    }
     if (strcmp(cmd, "intersections") == 0)
         return cs_intersections_main(argc - 1, argv + 1);
     if (strcmp(cmd, "render") == 0)

@@ -434,43 +434,96 @@ static void frames_kept(int written, char *buf, size_t len)
         snprintf(buf, len, "no frame is");
 }
 
-/* Simulates and writes; returns the exit status. */
+/* Rank 0, after a frame simulated: the frame file, its record and the
+ * summary. Returns CS_EXIT_OK to go on, a status to stop with the report,
+ * or minus a status to stop without it. */
+static int record_frame(run_state *r, int frame, const cs_frame_stats *stats, double seconds,
+                        cs_progress *progress, double sim_start)
+{
+    char err[ERRLEN];
+    cs_summary *s = &r->summary;
+    if (interrupted) { /* arrived during the frame: write nothing more */
+        s->status = "interrupted";
+        return CS_EXIT_INTERRUPTED;
+    }
+    cs_frame_record rec = {
+        .frame = frame,
+        .time = cs_sim_time(r->sim),
+        .stats = *stats,
+        .seconds = seconds,
+        .body_penetration = cs_plan_has(cs_sim_plan(r->sim), CS_STAGE_BODY_COLLISION)
+                                ? cs_sim_body_penetration(r->sim)
+                                : -1,
+    };
+    if (write_frame(r, frame, err, sizeof err) != CS_IMPORT_OK) {
+        cs_progress_finish(progress);
+        fprintf(stderr, "clothsim: %s\n", err);
+        s->status = "failed";
+        s->error = "a frame file could not be written";
+        s->failed_frame = frame;
+        return CS_EXIT_OUTPUT;
+    }
+    if (cs_summary_add_frame(s, &rec) != 0) {
+        cs_progress_finish(progress);
+        fprintf(stderr, "clothsim: out of memory\n");
+        s->status = "failed";
+        s->error = "out of memory";
+        return CS_EXIT_OUTPUT;
+    }
+    if (write_summary(r, err, sizeof err) != 0) {
+        cs_progress_finish(progress);
+        fprintf(stderr, "clothsim: %s\n", err);
+        return -CS_EXIT_OUTPUT;
+    }
+    cs_progress_frame(progress, frame, rec.time, now_seconds() - sim_start);
+    if (!interrupted)
+        return CS_EXIT_OK;
+    s->status = "interrupted"; /* the frame is kept; nothing more is simulated */
+    return CS_EXIT_INTERRUPTED;
+}
+
+/* Rank 0 writes, prints and decides; the others simulate their particles
+ * and follow its decision after every frame (cs_sim_agree), so a failed
+ * write or an interrupt stops every rank at the same frame. */
 static int simulate(run_state *r, const run_options *o)
 {
     char err[ERRLEN];
     cs_summary *s = &r->summary;
+    bool root = cs_sim_rank(r->sim) == 0;
     int status = CS_EXIT_OK;
 
-    if (cs_make_dirs(r->frames_dir) != 0) {
-        fprintf(stderr, "clothsim: cannot create %s: %s\n", r->frames_dir, strerror(errno));
-        return CS_EXIT_OUTPUT;
-    }
-    if (remove_old_frames(r->frames_dir, err, sizeof err) != 0) {
-        fprintf(stderr, "clothsim: %s\n", err);
-        return CS_EXIT_OUTPUT;
-    }
     install_signal_handlers();
+    if (root) {
+        if (cs_make_dirs(r->frames_dir) != 0) {
+            fprintf(stderr, "clothsim: cannot create %s: %s\n", r->frames_dir, strerror(errno));
+            status = CS_EXIT_OUTPUT;
+        } else if (remove_old_frames(r->frames_dir, err, sizeof err) != 0) {
+            fprintf(stderr, "clothsim: %s\n", err);
+            status = CS_EXIT_OUTPUT;
+        }
+    }
+    if ((status = cs_sim_agree(r->sim, status)) != CS_EXIT_OK)
+        return status;
 
     cs_progress progress;
-    cs_progress_init(&progress, stderr, o->quiet, r->scene->frames);
+    cs_progress_init(&progress, stderr, o->quiet || !root, r->scene->frames);
 
-    if (interrupted) {
-        s->status = "interrupted";
-        status = CS_EXIT_INTERRUPTED;
-    } else if (write_frame(r, 0, err, sizeof err) != CS_IMPORT_OK ||
-               write_summary(r, err, sizeof err) != 0) {
-        fprintf(stderr, "clothsim: %s\n", err);
-        return CS_EXIT_OUTPUT;
+    if (root) {
+        if (interrupted) {
+            s->status = "interrupted";
+            status = CS_EXIT_INTERRUPTED;
+        } else if (write_frame(r, 0, err, sizeof err) != CS_IMPORT_OK ||
+                   write_summary(r, err, sizeof err) != 0) {
+            fprintf(stderr, "clothsim: %s\n", err);
+            status = -CS_EXIT_OUTPUT; /* stop without the report */
+        }
     }
+    if ((status = cs_sim_agree(r->sim, status)) < 0)
+        return -status;
 
     cs_progress_frame(&progress, 0, cs_sim_time(r->sim), 0.0);
     double sim_start = now_seconds();
     for (int frame = 1; status == CS_EXIT_OK && frame <= r->scene->frames; frame++) {
-        if (interrupted) {
-            s->status = "interrupted";
-            status = CS_EXIT_INTERRUPTED;
-            break;
-        }
         cs_frame_stats stats;
         memset(&stats, 0, sizeof stats);
         double t0 = now_seconds();
@@ -478,14 +531,15 @@ static int simulate(run_state *r, const run_options *o)
         double seconds = now_seconds() - t0;
         s->simulation_seconds += seconds;
 
-        if (rc == CS_ERR_UNSTABLE) {
+        if (rc == CS_ERR_UNSTABLE) { /* every rank sees the same rc */
             cs_progress_finish(&progress);
             char kept[64];
             frames_kept(s->frames_written, kept, sizeof kept);
-            fprintf(stderr,
-                    "clothsim: the simulation became unstable in frame %d (t=%.4g s): "
-                    "NaN or runaway velocity; %s in %s\n",
-                    frame, cs_sim_time(r->sim), kept, r->frames_dir);
+            if (root)
+                fprintf(stderr,
+                        "clothsim: the simulation became unstable in frame %d (t=%.4g s): "
+                        "NaN or runaway velocity; %s in %s\n",
+                        frame, cs_sim_time(r->sim), kept, r->frames_dir);
             s->status = "unstable";
             s->error = "NaN or runaway velocity";
             s->failed_frame = frame;
@@ -494,53 +548,23 @@ static int simulate(run_state *r, const run_options *o)
         }
         if (rc != CS_OK) {
             cs_progress_finish(&progress);
-            fprintf(stderr, "clothsim: frame %d failed (%s)\n", frame,
-                    rc == CS_ERR_NOMEM ? "out of memory" : "simulation error");
+            if (root)
+                fprintf(stderr, "clothsim: frame %d failed (%s)\n", frame,
+                        rc == CS_ERR_NOMEM ? "out of memory" : "simulation error");
             s->status = "failed";
             s->error = rc == CS_ERR_NOMEM ? "out of memory" : "simulation error";
             s->failed_frame = frame;
             status = CS_EXIT_OUTPUT;
             break;
         }
-        if (interrupted) {   /* arrived during the frame: write nothing more */
-            s->status = "interrupted";
-            status = CS_EXIT_INTERRUPTED;
-            break;
-        }
-        cs_frame_record rec = {
-            .frame = frame,
-            .time = cs_sim_time(r->sim),
-            .stats = stats,
-            .seconds = seconds,
-            .body_penetration = cs_plan_has(cs_sim_plan(r->sim), CS_STAGE_BODY_COLLISION)
-                                    ? cs_sim_body_penetration(r->sim)
-                                    : -1,
-        };
-        if (write_frame(r, frame, err, sizeof err) != CS_IMPORT_OK) {
-            cs_progress_finish(&progress);
-            fprintf(stderr, "clothsim: %s\n", err);
-            s->status = "failed";
-            s->error = "a frame file could not be written";
-            s->failed_frame = frame;
-            status = CS_EXIT_OUTPUT;
-            break;
-        }
-        if (cs_summary_add_frame(s, &rec) != 0) {
-            cs_progress_finish(&progress);
-            fprintf(stderr, "clothsim: out of memory\n");
-            s->status = "failed";
-            s->error = "out of memory";
-            status = CS_EXIT_OUTPUT;
-            break;
-        }
-        if (write_summary(r, err, sizeof err) != 0) {
-            cs_progress_finish(&progress);
-            fprintf(stderr, "clothsim: %s\n", err);
-            return CS_EXIT_OUTPUT;
-        }
-        cs_progress_frame(&progress, frame, rec.time, now_seconds() - sim_start);
+        if (root)
+            status = record_frame(r, frame, &stats, seconds, &progress, sim_start);
+        if ((status = cs_sim_agree(r->sim, status)) < 0)
+            return -status;
     }
     cs_progress_finish(&progress);
+    if (!root)
+        return status;
 
     if (status == CS_EXIT_OK)
         s->status = "ok";
@@ -578,22 +602,27 @@ int cs_run_main(int argc, char **argv)
     cs_scene *scene = NULL;
     char err[ERRLEN] = "";
 
+    /* every rank loads the scene: the same file gives the same result, so
+     * only rank 0 speaks */
+    bool root = cs_parallel_rank() == 0;
     int rc = cs_scene_load(o.scene_path, o.noverrides, (const char *const *)o.overrides, &scene,
                            err, sizeof err);
     if (rc != CS_IMPORT_OK) {
-        fprintf(stderr, "clothsim: %s\n", err[0] ? err : "cannot load the scene");
+        if (root)
+            fprintf(stderr, "clothsim: %s\n", err[0] ? err : "cannot load the scene");
         status = rc == CS_IMPORT_BAD_INPUT ? CS_EXIT_INPUT : CS_EXIT_OUTPUT;
         goto done;
     }
     r.scene = scene;
-    for (int i = 0; i < scene->nnotes; i++) /* what import did with mesh files */
+    for (int i = 0; i < scene->nnotes && root; i++) /* what import did with mesh files */
         fprintf(stderr, "clothsim: %s\n", scene->notes[i]);
 
     const char *format_name = o.format ? o.format : scene->output_format;
     if (!format_name)
         format_name = "ply";
     if (!cs_mesh_format_from_name(format_name, &r.format)) {
-        fprintf(stderr, "clothsim: %s: output.format '%s' is not one of ply, obj, glb\n",
+        if (root)
+            fprintf(stderr, "clothsim: %s: output.format '%s' is not one of ply, obj, glb\n",
                 scene->path, format_name);
         status = CS_EXIT_INPUT;
         goto done;
@@ -601,12 +630,14 @@ int cs_run_main(int argc, char **argv)
 
     r.sim = cs_sim_create(&scene->def, err, sizeof err);
     if (!r.sim) {
-        fprintf(stderr, "clothsim: %s: %s\n", scene->path, err[0] ? err : "invalid scene");
+        if (root)
+            fprintf(stderr, "clothsim: %s: %s\n", scene->path, err[0] ? err : "invalid scene");
         status = CS_EXIT_INPUT;
         goto done;
     }
     if (o.plan_only) {
-        print_plan(scene, r.sim, stdout);
+        if (root)
+            print_plan(scene, r.sim, stdout);
         status = CS_EXIT_OK;
         goto done;
     }
@@ -655,7 +686,7 @@ int cs_run_main(int argc, char **argv)
     s->triangles = triangles;
     s->plan = *cs_sim_plan(r.sim);
 
-    if (o.render) {
+    if (o.render && root) {
         r.render = cs_run_render_create(scene, r.sim, o.render, o.render_size, o.render_samples,
                                         r.out_dir, &status);
         if (!r.render) {

@@ -38,10 +38,16 @@ int cs_summary_add_frame(cs_summary *s, const cs_frame_record *frame)
 void cs_summary_take_timing(cs_summary *s, const cs_sim *sim)
 {
     const cs_stage_timing *t = cs_sim_stage_timing(sim);
+    const cs_comm_stats *c = cs_sim_stage_comm(sim);
     for (int i = 0; i < CS_STAGE_COUNT; i++) {
         s->timing[i] = t ? t[i] : (cs_stage_timing){0, 0};
         s->bytes[i] = cs_sim_stage_bytes(sim, (cs_stage)i);
+        s->comm[i] = c ? c[i] : (cs_comm_stats){0, 0, 0};
     }
+    s->ranks = cs_sim_ranks(sim);
+    const cs_comm_stats *per_rank = cs_sim_rank_comm(sim);
+    for (int r = 0; r < s->ranks && r < CS_SUMMARY_MAX_RANKS; r++)
+        s->rank_comm[r] = per_rank[r];
 }
 
 static double stage_total(const cs_summary *s)
@@ -115,6 +121,7 @@ static cJSON *build_json(const cs_summary *s, builder *b)
     add_num(b, root, "steps_per_frame", s->steps_per_frame);
     add_num(b, root, "particles", s->particles);
     add_num(b, root, "triangles", s->triangles);
+    add_num(b, root, "ranks", s->ranks > 0 ? s->ranks : 1);
 
     cJSON *plan = add_array(b, root, "plan");
     for (int i = 0; i < s->plan.nstages; i++)
@@ -131,8 +138,22 @@ static cJSON *build_json(const cs_summary *s, builder *b)
             add_num(b, o, "share", total > 0 ? s->timing[st].seconds / total : 0.0);
             add_num(b, o, "calls", (double)s->timing[st].calls);
             add_num(b, o, "bytes", (double)s->bytes[st]);
+            add_num(b, o, "communication_seconds", s->comm[st].seconds);
+            add_num(b, o, "bytes_sent", (double)s->comm[st].bytes);
+            add_num(b, o, "messages_sent", (double)s->comm[st].messages);
         }
         append(b, stages, o);
+    }
+    cJSON *ranks = add_array(b, root, "communication");
+    for (int r = 0; r < s->ranks && r < CS_SUMMARY_MAX_RANKS; r++) {
+        cJSON *o = cJSON_CreateObject();
+        if (o) {
+            add_num(b, o, "rank", r);
+            add_num(b, o, "seconds", s->rank_comm[r].seconds);
+            add_num(b, o, "bytes_sent", (double)s->rank_comm[r].bytes);
+            add_num(b, o, "messages_sent", (double)s->rank_comm[r].messages);
+        }
+        append(b, ranks, o);
     }
     add_num(b, root, "total_seconds", s->total_seconds);
     add_num(b, root, "simulation_seconds", s->simulation_seconds);
@@ -230,16 +251,28 @@ void cs_summary_print_table(const cs_summary *s, FILE *out)
     double total = stage_total(s);
     long calls_total = 0;
 
-    fprintf(out, "\n%-*s  %10s  %7s  %9s\n", width, "stage", "seconds", "share", "calls");
+    /* "comm": of the stage's seconds, those spent in messages (Table 2's
+     * communication row, split by stage); with several ranks the seconds
+     * are the slowest rank's */
+    double comm_total = 0;
+    long bytes_total = 0;
+    fprintf(out, "\n%-*s  %10s  %10s  %7s  %9s  %12s\n", width, "stage", "seconds", "comm",
+            "share", "calls", "bytes sent");
     for (int i = 0; i < s->plan.nstages; i++) {
         cs_stage st = s->plan.stages[i];
         const cs_stage_timing *t = &s->timing[st];
-        fprintf(out, "%-*s  %10.3f  %6.1f%%  %9ld\n", width, cs_stage_name(st), t->seconds,
-                total > 0 ? 100.0 * t->seconds / total : 0.0, t->calls);
+        fprintf(out, "%-*s  %10.3f  %10.3f  %6.1f%%  %9ld  %12ld\n", width, cs_stage_name(st),
+                t->seconds, s->comm[st].seconds,
+                total > 0 ? 100.0 * t->seconds / total : 0.0, t->calls, s->comm[st].bytes);
         calls_total += t->calls;
+        comm_total += s->comm[st].seconds;
+        bytes_total += s->comm[st].bytes;
     }
-    fprintf(out, "%-*s  %10.3f  %6.1f%%  %9ld\n", width, "all stages", total,
-            total > 0 ? 100.0 : 0.0, calls_total);
+    fprintf(out, "%-*s  %10.3f  %10.3f  %6.1f%%  %9ld  %12ld\n", width, "all stages", total,
+            comm_total, total > 0 ? 100.0 : 0.0, calls_total, bytes_total);
+    if (s->ranks > 1)
+        fprintf(out, "%d ranks; summary.json lists the bytes and messages each sent\n",
+                s->ranks);
 
     int simulated = s->nframes;
     fprintf(out, "\nwall time %.3f s (simulation %.3f s, output %.3f s)\n",

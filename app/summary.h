@@ -13,6 +13,9 @@
 
 #include "sim/sim.h"
 
+/* Ranks listed one by one in summary.json (more are summed in "stages"). */
+#define CS_SUMMARY_MAX_RANKS 1024
+
 /* One simulated frame (frame 0, the initial state, has none). */
 typedef struct cs_frame_record {
     int frame;
@@ -44,6 +47,9 @@ typedef struct cs_summary {
     cs_plan plan;
     cs_stage_timing timing[CS_STAGE_COUNT];
     size_t bytes[CS_STAGE_COUNT];
+    cs_comm_stats comm[CS_STAGE_COUNT];   /* messages per stage, all ranks */
+    int ranks;
+    cs_comm_stats rank_comm[CS_SUMMARY_MAX_RANKS]; /* sent by each rank */
     double total_seconds;            /* wall time of the whole command so far */
     double simulation_seconds;       /* of which in cs_sim_advance_frame */
     double output_seconds;           /* of which writing frame files */

@@ -1,5 +1,6 @@
 /* bvh.c: build, refit and pair traversal of box hierarchies. */
 #include <math.h>
+#include <limits.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -88,6 +89,8 @@ void cs_bvh_free(cs_bvh *t)
     free(t->count);
     free(t->order);
     free(t->dirty);
+    free(t->rank_lo);
+    free(t->rank_hi);
     memset(t, 0, sizeof *t);
 }
 
@@ -120,6 +123,7 @@ typedef struct traversal {
     const cs_bvh *A, *B;
     const cs_box *box_a, *box_b;
     bool self, only_dirty;
+    int rank;
     cs_bvh_pair_fn fn;
     void *ctx;
 } traversal;
@@ -147,6 +151,13 @@ static void descend(const traversal *tr, int i, int j)
     const cs_bvh *A = tr->A, *B = tr->B;
     if (tr->only_dirty && !A->dirty[i] && !B->dirty[j])
         return;
+    if (tr->rank >= 0 && A->rank_lo && B->rank_lo) {
+        /* every pair below goes to a rank in [lo, hi]: none is ours */
+        int lo = A->rank_lo[i] < B->rank_lo[j] ? A->rank_lo[i] : B->rank_lo[j];
+        int hi = A->rank_hi[i] < B->rank_hi[j] ? A->rank_hi[i] : B->rank_hi[j];
+        if (tr->rank < lo || tr->rank > hi)
+            return;
+    }
     if (tr->self && i == j) {
         int l = A->child[2 * i];
         if (l < 0) {
@@ -190,6 +201,43 @@ void cs_bvh_pairs(const cs_bvh *A, const cs_bvh *B, const cs_box *box_a, const c
 {
     if (A->nnodes == 0 || B->nnodes == 0)
         return;
-    traversal tr = {A, B, box_a, box_b, A == B, only_dirty, fn, ctx};
+    traversal tr = {A, B, box_a, box_b, A == B, only_dirty, -1, fn, ctx};
     descend(&tr, 0, 0);
+}
+
+void cs_bvh_pairs_for_rank(const cs_bvh *A, const cs_bvh *B, const cs_box *box_a,
+                           const cs_box *box_b, bool only_dirty, int rank, cs_bvh_pair_fn fn,
+                           void *ctx)
+{
+    if (A->nnodes == 0 || B->nnodes == 0)
+        return;
+    traversal tr = {A, B, box_a, box_b, A == B, only_dirty, rank, fn, ctx};
+    descend(&tr, 0, 0);
+}
+
+int cs_bvh_set_ranks(cs_bvh *t, const int *prim_rank)
+{
+    if (!t->rank_lo) {
+        t->rank_lo = malloc(sizeof *t->rank_lo * ((size_t)t->nnodes + 1));
+        t->rank_hi = malloc(sizeof *t->rank_hi * ((size_t)t->nnodes + 1));
+        if (!t->rank_lo || !t->rank_hi)
+            return -1;
+    }
+    for (int node = t->nnodes - 1; node >= 0; node--) { /* children first */
+        int l = t->child[2 * node], lo = INT_MAX, hi = INT_MIN;
+        if (l < 0) {
+            for (int k = t->first[node]; k < t->first[node] + t->count[node]; k++) {
+                int r = prim_rank[t->order[k]];
+                lo = r < lo ? r : lo;
+                hi = r > hi ? r : hi;
+            }
+        } else {
+            int r = t->child[2 * node + 1];
+            lo = t->rank_lo[l] < t->rank_lo[r] ? t->rank_lo[l] : t->rank_lo[r];
+            hi = t->rank_hi[l] > t->rank_hi[r] ? t->rank_hi[l] : t->rank_hi[r];
+        }
+        t->rank_lo[node] = lo;
+        t->rank_hi[node] = hi;
+    }
+    return 0;
 }

@@ -22,6 +22,7 @@ typedef struct cs_bvh {
     int *first, *count;   /* leaf: primitives order[first .. first+count) */
     int *order;           /* primitive ids in leaf order */
     unsigned char *dirty; /* per node, from cs_bvh_refit's dirty input */
+    int *rank_lo, *rank_hi; /* per node: the ranks its primitives go to */
 } cs_bvh;
 
 int cs_bvh_build(cs_bvh *t, int nprims, const cs_box *prim_box);
@@ -35,6 +36,15 @@ void cs_bvh_refit(cs_bvh *t, const cs_box *prim_box, const unsigned char *prim_d
 typedef void (*cs_bvh_pair_fn)(void *ctx, int a, int b);
 void cs_bvh_pairs(const cs_bvh *A, const cs_bvh *B, const cs_box *box_a, const cs_box *box_b,
                   bool only_dirty, cs_bvh_pair_fn fn, void *ctx);
+
+/* Section 7: each primitive's rank (the lowest owner of its particles); a
+ * pair goes to the lower of its two primitives' ranks. */
+int cs_bvh_set_ranks(cs_bvh *t, const int *prim_rank);
+/* cs_bvh_pairs pruned to the node pairs that can hold a pair going to
+ * rank (after cs_bvh_set_ranks on both trees); fn still checks each pair. */
+void cs_bvh_pairs_for_rank(const cs_bvh *A, const cs_bvh *B, const cs_box *box_a,
+                           const cs_box *box_b, bool only_dirty, int rank, cs_bvh_pair_fn fn,
+                           void *ctx);
 
 static inline bool cs_box_overlap(const cs_box *a, const cs_box *b)
 {

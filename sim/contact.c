@@ -161,12 +161,14 @@ static void visit(collide_ctx *c, int i, int b)
 void cs_body_collide(cs_sim *sim, double dt)
 {
     int n = sim->n, nb = sim->nbodies;
-    memcpy(sim->v_star, sim->v, sizeof *sim->v * 3 * (size_t)n);
-    for (int i = 0; i < n; i++)
+    CS_FOR_OWNED(sim->par, i) {
+        memcpy(sim->v_star + 3 * i, sim->v + 3 * i, 3 * sizeof(double));
         sim->contact_body[i] = -1;
+    }
 
+    /* each rank: its own free particles (sim->active) */
     cs_body_grid g;
-    cs_body_grid_build(&g, sim->bodies, nb, sim->t + dt, sim->x, sim->is_free, n);
+    cs_body_grid_build(&g, sim->bodies, nb, sim->t + dt, sim->x, sim->active, n);
     collide_ctx c = {.sim = sim, .g = &g, .t1 = sim->t + dt, .dt = dt,
                      .improved = sim->def.friction_method == CS_FRICTION_IMPROVED};
     c.q.all_from = nb;
@@ -186,8 +188,8 @@ void cs_body_collide(cs_sim *sim, double dt)
     }
     for (int b = 0; b < nb; b++) {
         if (!g.ok || !g.bounded[b] || b >= c.q.all_from) {
-            for (int i = 0; i < n; i++)
-                if (sim->is_free[i])
+            CS_FOR_OWNED(sim->par, i)
+                if (sim->active[i])
                     visit(&c, i, b);
             continue;
         }
@@ -197,7 +199,7 @@ void cs_body_collide(cs_sim *sim, double dt)
         for (int e = c.q.head[b]; e >= 0; e = c.q.next[e])
             visit(&c, c.q.point[e], b);
     }
-    for (int i = 0; i < n; i++)
+    CS_FOR_OWNED(sim->par, i)
         if (sim->contact_body[i] >= 0) {
             sim->mode[i] = CS_CONTACT;
             sim->contacts++;
@@ -214,7 +216,7 @@ void cs_body_collide(cs_sim *sim, double dt)
 void cs_body_friction(cs_sim *sim, double dt)
 {
     double t1 = sim->t + dt;
-    for (int i = 0; i < sim->n; i++) {
+    CS_FOR_OWNED(sim->par, i) {
         int b = sim->contact_body[i];
         if (b < 0)
             continue;

@@ -3,6 +3,7 @@
 #ifndef CS_INTERNAL_H
 #define CS_INTERNAL_H
 
+#include "sim/par.h"
 #include "sim/sim.h"
 #include "sim/selfcol.h"
 #include "sim/springs.h"
@@ -59,15 +60,22 @@ struct cs_sim {
     double *wind_area;            /* 1 per particle */
 
     double t, dt, stable_dt, h;   /* h: half step of the current solve */
+    cs_par *par;                  /* ownership, ghosts, messages (Section 7) */
+    unsigned char *active;        /* free and owned here: bodies act on these */
     cs_stage_timing timing[CS_STAGE_COUNT];
+    /* rank 0 after a frame: over all ranks (see cs_sim_stage_timing) */
+    cs_stage_timing timing_all[CS_STAGE_COUNT];
+    cs_comm_stats comm_all[CS_STAGE_COUNT];
+    cs_comm_stats *rank_comm;     /* per rank totals */
     size_t stage_bytes[CS_STAGE_COUNT];
     long cg_iterations, contacts;
 };
 
 /* cg.c: solves P (M - h D) P z = P (rhs - (M - h D) v0) for v = v0 + z,
- * where P projects out fixed velocities and contact normals. Returns the
- * iteration count. */
-int cs_cg_solve(cs_sim *sim, const double *v0, const double *rhs, double *v);
+ * where P projects out fixed velocities and contact normals, over all
+ * ranks (v0's ghosts are refreshed first; v is written where owned).
+ * Returns the iteration count, the same on every rank. */
+int cs_cg_solve(cs_sim *sim, double *v0, const double *rhs, double *v);
 /* out = (M - h D) v, D the damping (and wind drag) velocity Jacobian. */
 void cs_system_apply(const cs_sim *sim, const double *v, double *out);
 /* out += D v (damping plus implicit wind drag). */

@@ -37,6 +37,27 @@ static int pair_push(cs_pair_list *l, const int v[4], const double *s0)
     return 0;
 }
 
+static int zone_find(int *parent, int i)
+{
+    while (parent[i] != i) {
+        parent[i] = parent[parent[i]];
+        i = parent[i];
+    }
+    return i;
+}
+
+static void zone_union(int *parent, int a, int b)
+{
+    if (parent[a] < 0)
+        parent[a] = a;
+    if (parent[b] < 0)
+        parent[b] = b;
+    a = zone_find(parent, a);
+    b = zone_find(parent, b);
+    if (a != b)
+        parent[a < b ? b : a] = a < b ? a : b;
+}
+
 cs_selfcol *cs_selfcol_create(const cs_sim *sim)
 {
     cs_selfcol *sc = calloc(1, sizeof *sc);
@@ -99,6 +120,13 @@ cs_selfcol *cs_selfcol_create(const cs_sim *sim)
     sc->inv_mass = malloc(sizeof(double) * (size_t)(n + 1));
     sc->zone = malloc(sizeof(int) * (size_t)(n + 1));
     sc->zone_list = malloc(sizeof(int) * (size_t)(n + 1));
+    int most = n > ne ? n : ne;
+    most = most > nt ? most : nt;
+    sc->prim_rank = malloc(sizeof(int) * (size_t)(most + 1));
+    sc->component = malloc(sizeof(int) * (size_t)(n + 1));
+    sc->x_pass = malloc(sizeof(double) * 3 * (size_t)(n + 1));
+    if (!sc->prim_rank || !sc->component || !sc->x_pass)
+        goto fail;
     if (!sc->pbox || !sc->ebox || !sc->tbox || !sc->pdirty || !sc->vdirty || !sc->edirty ||
         !sc->tdirty || !sc->x_free || !sc->x_before || !sc->inv_mass || !sc->zone ||
         !sc->zone_list)
@@ -130,8 +158,8 @@ cs_selfcol *cs_selfcol_create(const cs_sim *sim)
     if (cs_bvh_build(&sc->ptree, n, sc->pbox) || cs_bvh_build(&sc->etree, ne, sc->ebox) ||
         cs_bvh_build(&sc->ttree, nt, sc->tbox))
         goto fail;
-    sc->bytes = sizeof(cs_box) * (size_t)(n + ne + nt) * 3 + sizeof(double) * 10 * (size_t)n +
-                sizeof(int) * (size_t)(2 * ne + 3 * nt + 2 * n);
+    sc->bytes = sizeof(cs_box) * (size_t)(n + ne + nt) * 3 + sizeof(double) * 13 * (size_t)n +
+                sizeof(int) * (size_t)(2 * ne + 3 * nt + 3 * n + most);
     return sc;
 fail:
     cs_selfcol_destroy(sc);
@@ -147,9 +175,11 @@ void cs_selfcol_destroy(cs_selfcol *sc)
     cs_bvh_free(&sc->ttree);
     void *arrays[] = {sc->edge, sc->tri, sc->ring_start, sc->ring, sc->pbox, sc->ebox, sc->tbox, sc->pdirty, sc->edirty,
                       sc->tdirty, sc->vdirty, sc->x_free, sc->x_before, sc->inv_mass, sc->zone,
-                      sc->zone_list, sc->pt.p, sc->ee.p, sc->cpt.p, sc->cee.p};
+                      sc->zone_list, sc->pt.p, sc->ee.p, sc->cpt.p, sc->cee.p,
+                      sc->prim_rank, sc->component, sc->bpt.p, sc->bee.p, sc->x_pass};
     for (size_t k = 0; k < sizeof arrays / sizeof *arrays; k++)
         free(arrays[k]);
+    cs_halo_free(&sc->bhalo);
     free(sc);
 }
 
@@ -381,6 +411,146 @@ static bool wing_pair(const cs_selfcol *sc, int point, const int *tri)
     return joined >= 2;
 }
 
+/* ------------------------------------------------- Section 7: ranks */
+
+static int pair_rank(const cs_par *par, const int v[4])
+{
+    int r = par->owner[v[0]];
+    for (int k = 1; k < 4; k++)
+        r = par->owner[v[k]] < r ? par->owner[v[k]] : r;
+    return r;
+}
+
+static bool pair_internal(const cs_par *par, const int v[4])
+{
+    for (int k = 0; k < 4; k++)
+        if (par->owner[v[k]] != par->rank)
+            return false;
+    return true;
+}
+
+int cs_selfcol_set_ranks(cs_sim *sim)
+{
+    cs_selfcol *sc = sim->selfcol;
+    const int *owner = sim->par->owner;
+    if (sim->par->size == 1)
+        return 0; /* nothing to prune */
+    int *r = sc->prim_rank;
+    for (int i = 0; i < sc->n; i++)
+        r[i] = owner[i];
+    if (cs_bvh_set_ranks(&sc->ptree, r))
+        return -1;
+    for (int k = 0; k < sc->ne; k++) {
+        int a = owner[sc->edge[2 * k]], b = owner[sc->edge[2 * k + 1]];
+        r[k] = a < b ? a : b;
+    }
+    if (cs_bvh_set_ranks(&sc->etree, r))
+        return -1;
+    for (int k = 0; k < sc->nt; k++) {
+        int m = owner[sc->tri[3 * k]];
+        for (int j = 1; j < 3; j++)
+            m = owner[sc->tri[3 * k + j]] < m ? owner[sc->tri[3 * k + j]] : m;
+        r[k] = m;
+    }
+    return cs_bvh_set_ranks(&sc->ttree, r);
+}
+
+/* A pair as sent between ranks. */
+typedef struct wire_pair {
+    int v[4];
+    int is_edge, rank; /* rank: the rank that found it */
+    double s0[3];
+} wire_pair;
+
+/* Fig. 12's bookkeeping. Moves this rank's boundary pairs (a particle
+ * owned elsewhere) out of pt and ee, which keep the internal ones; every
+ * rank learns every boundary pair (four indices and a history vector: the
+ * internal pairs, nearly all of them, never leave their rank), joins them
+ * into connected components by flood fill (union-find over particles) and
+ * keeps in bpt and bee, in one Gauss-Seidel order, the pairs of the
+ * components it processes: those whose lowest finding rank it is. bhalo
+ * links their particles to their owners. Returns 0 or -1 (no memory). */
+static int distribute_boundary(cs_sim *sim, cs_pair_list *pt, cs_pair_list *ee)
+{
+    cs_selfcol *sc = sim->selfcol;
+    cs_par *par = sim->par;
+    sc->bpt.n = sc->bee.n = 0;
+    cs_halo_free(&sc->bhalo);
+    if (par->size == 1)
+        return 0;
+    int nmine = 0;
+    for (int l = 0; l < 2; l++) {
+        cs_pair_list *list = l == 0 ? pt : ee;
+        for (int i = 0; i < list->n; i++)
+            nmine += !pair_internal(par, list->p[i].v);
+    }
+    wire_pair *mine = malloc(sizeof *mine * ((size_t)nmine + 1));
+    if (!mine)
+        return -1;
+    int m = 0;
+    for (int l = 0; l < 2; l++) {
+        cs_pair_list *list = l == 0 ? pt : ee;
+        int kept = 0;
+        for (int i = 0; i < list->n; i++) {
+            cs_pair *q = list->p + i;
+            if (pair_internal(par, q->v)) {
+                list->p[kept++] = *q;
+                continue;
+            }
+            wire_pair *w = mine + m++;
+            memcpy(w->v, q->v, sizeof w->v);
+            memcpy(w->s0, q->s0, sizeof w->s0);
+            w->is_edge = l;
+            w->rank = par->rank;
+        }
+        list->n = kept;
+    }
+    void *gathered;
+    int nall;
+    int rc = cs_par_allgather_items(par, mine, nmine, sizeof *mine, &gathered, &nall);
+    free(mine);
+    if (rc)
+        return -1;
+    const wire_pair *all = gathered;
+
+    /* components, and the lowest finding rank of each (at its root) */
+    int *parent = sc->component, *root_rank = sc->prim_rank;
+    for (int i = 0; i < sc->n; i++)
+        parent[i] = -1;
+    for (int k = 0; k < nall; k++)
+        for (int j = 1; j < 4; j++)
+            zone_union(parent, all[k].v[0], all[k].v[j]);
+    for (int k = 0; k < nall; k++)
+        root_rank[zone_find(parent, all[k].v[0])] = par->size;
+    int *user = malloc(sizeof *user * (4 * (size_t)nall + 1));
+    int *particle = malloc(sizeof *particle * (4 * (size_t)nall + 1));
+    if (!user || !particle)
+        rc = -1;
+    for (int k = 0; k < nall; k++) {
+        int root = zone_find(parent, all[k].v[0]);
+        if (all[k].rank < root_rank[root])
+            root_rank[root] = all[k].rank;
+    }
+    for (int l = 0; l < 2 && !rc; l++) /* point/triangle pairs first, as on one rank */
+        for (int k = 0; k < nall && !rc; k++) {
+            if (all[k].is_edge != l)
+                continue;
+            int proc = root_rank[zone_find(parent, all[k].v[0])];
+            for (int j = 0; j < 4; j++) {
+                user[4 * k + j] = proc;
+                particle[4 * k + j] = all[k].v[j];
+            }
+            if (proc == par->rank)
+                rc = pair_push(l ? &sc->bee : &sc->bpt, all[k].v, all[k].s0);
+        }
+    if (!rc)
+        rc = cs_halo_from_needs(par, 4 * nall, user, particle, &sc->bhalo);
+    free(user);
+    free(particle);
+    free(gathered);
+    return rc;
+}
+
 /* ------------------------------------------------------------- step A */
 
 typedef struct finder {
@@ -415,6 +585,9 @@ static void found_point_triangle(void *ctx, int point, int t)
     const int *tri = sc->tri + 3 * t;
     if (point == tri[0] || point == tri[1] || point == tri[2] || wing_pair(sc, point, tri))
         return;
+    int quad[4] = {tri[0], tri[1], tri[2], point};
+    if (pair_rank(f->sim->par, quad) != f->sim->par->rank)
+        return; /* another rank's to find */
     if (sc->inv_mass[point] == 0 && sc->inv_mass[tri[0]] == 0 && sc->inv_mass[tri[1]] == 0 &&
         sc->inv_mass[tri[2]] == 0)
         return;
@@ -449,6 +622,9 @@ static void found_edge_edge(void *ctx, int ea, int eb)
     const int *a = sc->edge + 2 * ea, *b = sc->edge + 2 * eb;
     if (a[0] == b[0] || a[0] == b[1] || a[1] == b[0] || a[1] == b[1])
         return;
+    int quad[4] = {a[0], a[1], b[0], b[1]};
+    if (pair_rank(f->sim->par, quad) != f->sim->par->rank)
+        return; /* another rank's to find */
     if (sc->inv_mass[a[0]] == 0 && sc->inv_mass[a[1]] == 0 && sc->inv_mass[b[0]] == 0 &&
         sc->inv_mass[b[1]] == 0)
         return;
@@ -479,7 +655,8 @@ static void found_edge_edge(void *ctx, int ea, int eb)
 void cs_selfcol_find_pairs(cs_sim *sim, double span)
 {
     cs_selfcol *sc = sim->selfcol;
-    const double *x = sc->x_free;
+    const double *x = sc->x_free; /* the same on every rank */
+    cs_par_allgather(sim->par, sim->v, 3); /* velocities widen the boxes */
     double h = sim->def.self.thickness;
     sc->pt.n = sc->ee.n = 0;
     /* non-aggressive pruning: boxes grow by h/2 plus the distance each
@@ -515,17 +692,35 @@ void cs_selfcol_find_pairs(cs_sim *sim, double span)
     cs_bvh_refit(&sc->etree, sc->ebox, NULL);
     cs_bvh_refit(&sc->ttree, sc->tbox, NULL);
     finder f = {sim, sc, h, span, 0};
-    cs_bvh_pairs(&sc->ptree, &sc->ttree, sc->pbox, sc->tbox, false, found_point_triangle, &f);
-    cs_bvh_pairs(&sc->etree, &sc->etree, sc->ebox, sc->ebox, false, found_edge_edge, &f);
+    int rank = sim->par->rank;
+    cs_bvh_pairs_for_rank(&sc->ptree, &sc->ttree, sc->pbox, sc->tbox, false, rank,
+                          found_point_triangle, &f);
+    cs_bvh_pairs_for_rank(&sc->etree, &sc->etree, sc->ebox, sc->ebox, false, rank,
+                          found_edge_edge, &f);
     sc->stats.repulsion_pairs += sc->pt.n + sc->ee.n;
+    if (distribute_boundary(sim, &sc->pt, &sc->ee) != 0)
+        f.failed = 1;
+    if (f.failed) /* out of memory: without pairs step C still keeps the cloth apart */
+        sc->pt.n = sc->ee.n = sc->bpt.n = sc->bee.n = 0;
 }
 
-void cs_selfcol_repulse(cs_sim *sim, const double *x, double *v, double dt, bool elastic)
+/* Fig. 12: phase I, each rank its components of boundary pairs (their
+ * particles' state brought from the owners and the new velocities sent
+ * back); phase II, every rank its internal pairs. The result is that of
+ * one serial Gauss-Seidel order. */
+void cs_selfcol_repulse(cs_sim *sim, double *x, double *v, double dt, bool elastic)
 {
     cs_selfcol *sc = sim->selfcol;
+    cs_par *par = sim->par;
     const cs_self_collision_def *d = &sim->def.self;
     response r = {true, elastic, !elastic, dt, d->thickness, d->stiffness, d->friction,
                   d->edge_flip_epsilon};
+    if (par->size > 1) {
+        cs_halo_forward(par, &sc->bhalo, x, 3);
+        cs_halo_forward(par, &sc->bhalo, v, 3);
+        sc->stats.repulsions += cs_pairs_apply(sc, &sc->bpt, &sc->bee, x, v, &r);
+        cs_halo_reverse(par, &sc->bhalo, v, 3);
+    }
     sc->stats.repulsions += cs_pairs_apply(sc, &sc->pt, &sc->ee, x, v, &r);
 }
 
@@ -615,6 +810,7 @@ static bool pair_collides(const cs_selfcol *sc, const cs_pair *p, bool is_edge, 
 
 typedef struct collector {
     cs_selfcol *sc;
+    const cs_par *par;
     int failed;
 } collector;
 
@@ -626,7 +822,8 @@ static void cand_point_triangle(void *ctx, int point, int t)
     if (point == tri[0] || point == tri[1] || point == tri[2])
         return; /* wings stay: a wing point crossing drags its other triangles through */
     int v[4] = {tri[0], tri[1], tri[2], point};
-    cl->failed |= pair_push(&sc->cpt, v, NULL);
+    if (pair_rank(cl->par, v) == cl->par->rank)
+        cl->failed |= pair_push(&sc->cpt, v, NULL);
 }
 
 static void cand_edge_edge(void *ctx, int ea, int eb)
@@ -637,12 +834,14 @@ static void cand_edge_edge(void *ctx, int ea, int eb)
     if (a[0] == b[0] || a[0] == b[1] || a[1] == b[0] || a[1] == b[1])
         return;
     int v[4] = {a[0], a[1], b[0], b[1]};
-    cl->failed |= pair_push(&sc->cee, v, NULL);
+    if (pair_rank(cl->par, v) == cl->par->rank)
+        cl->failed |= pair_push(&sc->cee, v, NULL);
 }
 
 /* Swept boxes from the free positions to x, and the candidate pairs among
  * primitives (only near changed particles when only_dirty). */
-static void collect_candidates(cs_selfcol *sc, const double *x, bool only_dirty)
+static void collect_candidates(cs_selfcol *sc, const cs_par *par, const double *x,
+                               bool only_dirty)
 {
     double pad = sc->proximity;
     for (int i = 0; i < sc->n; i++) {
@@ -675,30 +874,11 @@ static void collect_candidates(cs_selfcol *sc, const double *x, bool only_dirty)
     cs_bvh_refit(&sc->etree, sc->ebox, sc->edirty);
     cs_bvh_refit(&sc->ttree, sc->tbox, sc->tdirty);
     sc->cpt.n = sc->cee.n = 0;
-    collector cl = {sc, 0};
-    cs_bvh_pairs(&sc->ptree, &sc->ttree, sc->pbox, sc->tbox, only_dirty, cand_point_triangle, &cl);
-    cs_bvh_pairs(&sc->etree, &sc->etree, sc->ebox, sc->ebox, only_dirty, cand_edge_edge, &cl);
-}
-
-static int zone_find(int *parent, int i)
-{
-    while (parent[i] != i) {
-        parent[i] = parent[parent[i]];
-        i = parent[i];
-    }
-    return i;
-}
-
-static void zone_union(int *parent, int a, int b)
-{
-    if (parent[a] < 0)
-        parent[a] = a;
-    if (parent[b] < 0)
-        parent[b] = b;
-    a = zone_find(parent, a);
-    b = zone_find(parent, b);
-    if (a != b)
-        parent[a < b ? b : a] = a < b ? a : b;
+    collector cl = {sc, par, 0};
+    cs_bvh_pairs_for_rank(&sc->ptree, &sc->ttree, sc->pbox, sc->tbox, only_dirty, par->rank,
+                          cand_point_triangle, &cl);
+    cs_bvh_pairs_for_rank(&sc->etree, &sc->etree, sc->ebox, sc->ebox, only_dirty, par->rank,
+                          cand_edge_edge, &cl);
 }
 
 /* Symmetric 3x3 eigen decomposition by cyclic Jacobi rotations:
@@ -827,16 +1007,118 @@ static void rigidify_zones(cs_sim *sim, double span, double *dv)
         }
         if (count > sc->stats.max_zone)
             sc->stats.max_zone = count;
+        for (int k = 1; k < count; k++)
+            if (sim->par->owner[sc->zone_list[k]] != sim->par->owner[sc->zone_list[0]]) {
+                sc->stats.zones_across++;
+                break;
+            }
     }
 }
 
+/* One colliding pair's response in step C: inelastic on the effective
+ * velocities u (the real velocity's change accumulates in dv), then an
+ * elastic push if the end positions are too close. Returns false when the
+ * pair no longer collides (an earlier response moved it). */
+static bool collision_respond(cs_selfcol *sc, const cs_pair *p, bool is_edge, double *x,
+                              double *u, double *dv, double span, const response *elastic)
+{
+    double c[4], nrm[3];
+    if (!pair_collides(sc, p, is_edge, x, c, nrm))
+        return false;
+    double inv_m = pair_inverse_mass(sc, p, c), rel[3];
+    if (!(inv_m > 0))
+        return true;
+    double un = pair_normal_velocity(p, c, u, nrm, rel);
+    if (un < 0) {
+        pair_impulse(sc, p, c, -un / inv_m, nrm, u);
+        pair_impulse(sc, p, c, -un / inv_m, nrm, dv);
+    }
+    for (int q = 0; q < 4; q++) {
+        int i = p->v[q];
+        for (int e = 0; e < 3; e++)
+            x[3 * i + e] = sc->x_free[3 * i + e] + span * u[3 * i + e];
+    }
+    if (pair_respond(sc, p, is_edge, x, u, elastic))
+        for (int q = 0; q < 4; q++) {
+            int i = p->v[q];
+            for (int e = 0; e < 3; e++)
+                x[3 * i + e] = sc->x_free[3 * i + e] + span * u[3 * i + e];
+        }
+    return true;
+}
+
+static void respond_all(cs_selfcol *sc, const cs_pair_list *pt, const cs_pair_list *ee,
+                        double *x, double *u, double *dv, double span, const response *elastic)
+{
+    for (int j = 0; j < pt->n; j++)
+        collision_respond(sc, pt->p + j, false, x, u, dv, span, elastic);
+    for (int j = 0; j < ee->n; j++)
+        collision_respond(sc, ee->p + j, true, x, u, dv, span, elastic);
+}
+
+/* Keeps the candidates that collide along the pass's trajectories. */
+static long keep_colliding(cs_selfcol *sc, const double *x)
+{
+    long found = 0;
+    for (int l = 0; l < 2; l++) {
+        cs_pair_list *list = l == 0 ? &sc->cpt : &sc->cee;
+        int kept = 0;
+        for (int j = 0; j < list->n; j++) {
+            double c[4], nrm[3];
+            if (pair_collides(sc, list->p + j, l == 1, x, c, nrm))
+                list->p[kept++] = list->p[j];
+        }
+        list->n = kept;
+        found += kept;
+    }
+    return found;
+}
+
+/* Impact zones over all ranks: every rank merges every colliding pair's
+ * particles in the same order, so all hold the same zones. Returns 0 or
+ * -1. */
+static int merge_zones(cs_sim *sim)
+{
+    cs_selfcol *sc = sim->selfcol;
+    int nmine = sc->cpt.n + sc->cee.n;
+    int *mine = malloc(sizeof *mine * 4 * ((size_t)nmine + 1));
+    if (!mine)
+        return -1;
+    for (int l = 0, m = 0; l < 2; l++) {
+        const cs_pair_list *list = l == 0 ? &sc->cpt : &sc->cee;
+        for (int j = 0; j < list->n; j++, m++)
+            memcpy(mine + 4 * m, list->p[j].v, 4 * sizeof *mine);
+    }
+    void *gathered;
+    int nall;
+    int rc = cs_par_allgather_items(sim->par, mine, nmine, 4 * sizeof *mine, &gathered, &nall);
+    free(mine);
+    if (rc)
+        return -1;
+    const int *all = gathered;
+    for (int k = 0; k < nall; k++)
+        for (int q = 1; q < 4; q++)
+            zone_union(sc->zone, all[4 * k], all[4 * k + q]);
+    free(gathered);
+    return 0;
+}
+
+/* Step C on several ranks: each pass starts from positions synchronised to
+ * every rank; each rank finds its assigned colliding pairs; responses run
+ * in Fig. 12's two phases (components of boundary pairs, results sent to
+ * the owners, then internal pairs); the pass count, the decision to stop
+ * and the impact zones are global. On one rank there are no messages and
+ * no boundary pairs. */
 long cs_selfcol_collide(cs_sim *sim, double span, int k, bool detect_only)
 {
     cs_selfcol *sc = sim->selfcol;
+    cs_par *par = sim->par;
     const cs_self_collision_def *d = &sim->def.self;
     int n = sc->n;
     double *x = sim->x;
-    memcpy(sc->x_before, x, sizeof(double) * 3 * (size_t)n);
+    size_t bytes = sizeof(double) * 3 * (size_t)n;
+    cs_par_allgather(par, x, 3);
+    memcpy(sc->x_before, x, bytes);
     for (int i = 0; i < n; i++) {
         sc->vdirty[i] = 1;
         sc->zone[i] = -1;
@@ -849,65 +1131,44 @@ long cs_selfcol_collide(cs_sim *sim, double span, int k, bool detect_only)
     /* The real velocity takes the inelastic changes only (impulses and
      * zones); the elastic push moves positions, as in B.2 (Section 5). */
     double *dv = sim->v0;
-    memset(dv, 0, sizeof(double) * 3 * (size_t)n);
+    memset(dv, 0, bytes);
     long first_pass = 0;
     int zones_formed = 0;
     for (int pass = 0;; pass++) {
-        collect_candidates(sc, x, pass > 0);
-        memset(sc->vdirty, 0, (size_t)n);
+        if (pass > 0) { /* what moved since the last pass, on any rank */
+            cs_par_allgather(par, x, 3);
+            for (int i = 0; i < n; i++)
+                sc->vdirty[i] = memcmp(x + 3 * i, sc->x_pass + 3 * i, 3 * sizeof *x) != 0;
+        }
+        memcpy(sc->x_pass, x, bytes);
+        collect_candidates(sc, par, x, pass > 0);
         sc->stats.passes++;
         bool zone_mode = pass >= d->zone_iterations;
-        long found = 0;
         for (int i = 0; i < n; i++)
             for (int c = 0; c < 3; c++)
                 u[3 * i + c] = (x[3 * i + c] - sc->x_free[3 * i + c]) / span;
-        for (int list = 0; list < 2; list++) {
-            cs_pair_list *l = list == 0 ? &sc->cpt : &sc->cee;
-            for (int j = 0; j < l->n; j++) {
-                cs_pair *p = l->p + j;
-                double c[4], nrm[3];
-                if (!pair_collides(sc, p, list == 1, x, c, nrm))
-                    continue;
-                found++;
-                if (detect_only)
-                    continue;
-                if (zone_mode) {
-                    for (int q = 1; q < 4; q++)
-                        zone_union(sc->zone, p->v[0], p->v[q]);
-                    continue;
-                }
-                /* inelastic: zero the relative normal effective velocity */
-                double inv_m = pair_inverse_mass(sc, p, c), rel[3];
-                if (!(inv_m > 0))
-                    continue;
-                double un = pair_normal_velocity(p, c, u, nrm, rel);
-                if (un < 0) {
-                    pair_impulse(sc, p, c, -un / inv_m, nrm, u);
-                    pair_impulse(sc, p, c, -un / inv_m, nrm, dv);
-                }
-                for (int q = 0; q < 4; q++) {
-                    int i = p->v[q];
-                    for (int e = 0; e < 3; e++)
-                        x[3 * i + e] = sc->x_free[3 * i + e] + span * u[3 * i + e];
-                    sc->vdirty[i] = 1;
-                }
-                /* then push apart if the end positions are too close */
-                if (pair_respond(sc, p, list == 1, x, u, &elastic))
-                    for (int q = 0; q < 4; q++) {
-                        int i = p->v[q];
-                        for (int e = 0; e < 3; e++)
-                            x[3 * i + e] = sc->x_free[3 * i + e] + span * u[3 * i + e];
-                    }
-            }
-        }
+        long found = keep_colliding(sc, x), found_all = found;
+        cs_par_sum_long(par, &found_all, 1);
         if (pass == 0)
-            first_pass = found;
+            first_pass = found_all;
         sc->stats.collisions += found;
-        if (detect_only || found == 0)
+        if (detect_only || found_all == 0)
             break;
         if (zone_mode) {
+            if (merge_zones(sim) != 0)
+                abort(); /* out of memory in the last resort: nothing safe to do */
             zones_formed++;
             rigidify_zones(sim, span, dv);
+        } else {
+            if (distribute_boundary(sim, &sc->cpt, &sc->cee) != 0)
+                abort();
+            /* phase I: the state is synchronised; results go to the owners */
+            respond_all(sc, &sc->bpt, &sc->bee, x, u, dv, span, &elastic);
+            cs_halo_reverse(par, &sc->bhalo, x, 3);
+            cs_halo_reverse(par, &sc->bhalo, u, 3);
+            cs_halo_reverse(par, &sc->bhalo, dv, 3);
+            /* phase II */
+            respond_all(sc, &sc->cpt, &sc->cee, x, u, dv, span, &elastic);
         }
         if (pass > d->zone_iterations + 1000) {
             /* cannot happen in exact arithmetic (zones only grow); stop
@@ -927,8 +1188,9 @@ long cs_selfcol_collide(cs_sim *sim, double span, int k, bool detect_only)
             roots += sc->zone[i] >= 0 && zone_find(sc->zone, i) == i;
         sc->stats.zones += roots;
     }
-    for (int k = 0; k < 3 * n; k++)
-        sim->v[k] += dv[k];
-    memcpy(sc->x_free, x, sizeof(double) * 3 * (size_t)n);
+    CS_FOR_OWNED(par, i)
+        for (int c = 0; c < 3; c++)
+            sim->v[3 * i + c] += dv[3 * i + c];
+    memcpy(sc->x_free, x, bytes); /* the same on every rank */
     return first_pass;
 }

@@ -10,6 +10,7 @@
 #define CS_SELFCOL_H
 
 #include "sim/bvh.h"
+#include "sim/par.h"
 
 typedef struct cs_sim cs_sim;
 
@@ -34,6 +35,7 @@ typedef struct cs_selfcol_stats {
     long passes;               /* step C iterations */
     long zones;                /* impact zones formed */
     long max_zone;             /* particles in the largest zone */
+    long zones_across;         /* zone rigidifications spanning ranks */
     long rewinds;              /* outer steps redone (rewind scheme) */
 } cs_selfcol_stats;
 
@@ -52,12 +54,24 @@ typedef struct cs_selfcol {
     cs_pair_list cpt, cee;     /* step C candidates of one pass */
     int *zone;                 /* union-find parent per particle, -1 outside zones */
     int *zone_list;            /* scratch */
+    /* Section 7: pairs go to the lowest rank owning one of their particles;
+     * pairs across ranks ("boundary") are grouped into connected components,
+     * each processed by one rank before the pairs internal to each rank */
+    int *prim_rank;            /* scratch for the trees' rank ranges */
+    int *component;            /* union-find parent per particle (scratch) */
+    cs_pair_list bpt, bee;     /* boundary repulsion pairs this rank processes */
+    cs_halo bhalo;             /* their particles: owners <-> this rank */
+    double *x_pass;            /* positions at the last step C pass's start */
     cs_selfcol_stats stats;
     size_t bytes;
 } cs_selfcol;
 
 cs_selfcol *cs_selfcol_create(const cs_sim *sim);
 void cs_selfcol_destroy(cs_selfcol *sc);
+
+/* After the partition: the trees learn which ranks their primitives go
+ * to. Returns 0 or -1 (no memory). */
+int cs_selfcol_set_ranks(cs_sim *sim);
 
 /* Step A: pairs near each other in the collision-free state (sim->x, which
  * equals x_free here) allowing for motion over the coming time span. */
@@ -66,7 +80,7 @@ void cs_selfcol_find_pairs(cs_sim *sim, double span);
 /* B.2 (elastic true): inelastic then elastic repulsion on v~^(n+1/2) with
  * positions x^n. B.8 (elastic false): inelastic repulsion and friction on
  * v^(n+1) with positions x^(n+1). */
-void cs_selfcol_repulse(cs_sim *sim, const double *x, double *v, double dt, bool elastic);
+void cs_selfcol_repulse(cs_sim *sim, double *x, double *v, double dt, bool elastic);
 
 /* Step C over the span since the last collision-free state, k time steps
  * of it. Updates x, v and the collision-free state. With detect_only,

@@ -53,6 +53,7 @@ cs_sim_def cs_default_sim_def(void)
     d.bodies_enabled = true;
     d.wind_enabled = false;
     d.self = cs_default_self_collision_def();
+    d.comm = MPI_COMM_WORLD;
     return d;
 }
 
@@ -63,7 +64,9 @@ static double now(void)
     return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
 }
 
-#define STAGE_BEGIN(sim, stage) double stage_t0_##stage = now()
+#define STAGE_BEGIN(sim, stage)                                        \
+    double stage_t0_##stage = now();                                   \
+    cs_par_begin((sim)->par, stage)
 #define STAGE_END(sim, stage)                                          \
     do {                                                               \
         (sim)->timing[stage].seconds += now() - stage_t0_##stage;      \
@@ -333,6 +336,18 @@ cs_sim *cs_sim_create(const cs_sim_def *def, char *err, size_t errlen)
         dt_max = frame;
     int steps = (int)ceil(frame / dt_max - 1e-9);
     sim->dt = frame / (steps > 0 ? steps : 1);
+
+    /* Section 7: owners and ghosts; each rank keeps the springs it needs */
+    sim->par = cs_par_create(def->comm, n, sim->x, sim->springs.n, sim->springs.ends);
+    sim->active = calloc((size_t)n + 1, 1);
+    sim->rank_comm = calloc((size_t)(sim->par ? sim->par->size : 1) + 1, sizeof *sim->rank_comm);
+    if (!sim->par || !sim->active || !sim->rank_comm)
+        goto nomem;
+    cs_springs_keep_touching(&sim->springs, sim->par->owner, sim->par->rank);
+    if (sim->selfcol && cs_selfcol_set_ranks(sim) != 0)
+        goto nomem;
+    for (int i = 0; i < n; i++)
+        sim->active[i] = sim->is_free[i] && cs_par_owns(sim->par, i);
     return sim;
 
 nomem:
@@ -361,6 +376,9 @@ void cs_sim_destroy(cs_sim *sim)
     free(sim->bodies);
     cs_springs_free(&sim->springs);
     cs_selfcol_destroy(sim->selfcol);
+    cs_par_destroy(sim->par);
+    free(sim->active);
+    free(sim->rank_comm);
     double *arrays[] = {sim->x, sim->v, sim->mass, sim->x_prev, sim->v_half, sim->v_star,
                         sim->v_next, sim->force, sim->v0, sim->rhs, sim->script_x,
                         sim->script_v, sim->contact_normal, sim->wind_normal, sim->wind_area, sim->v_rewind,
@@ -423,16 +441,18 @@ static void wind_geometry(cs_sim *sim, const double *x)
     }
 }
 
-/* force = elastic(x) + m g + explicit wind part, for free particles */
+/* force = elastic(x) + m g + explicit wind part, for owned particles (the
+ * springs also add into ghosts, which nobody reads) */
 static void explicit_forces(cs_sim *sim, const double *x)
 {
-    memset(sim->force, 0, sizeof(double) * 3 * (size_t)sim->n);
+    CS_FOR_LOCAL(sim->par, i)
+        sim->force[3 * i] = sim->force[3 * i + 1] = sim->force[3 * i + 2] = 0;
     cs_springs_add_elastic(&sim->springs, x, sim->force);
-    for (int i = 0; i < sim->n; i++)
+    CS_FOR_OWNED(sim->par, i)
         cs_axpy(sim->mass[i], sim->def.gravity, sim->force + 3 * i);
     if (sim->wind_normal) {
         double c = sim->def.wind.drag;
-        for (int i = 0; i < sim->n; i++) {
+        CS_FOR_OWNED(sim->par, i) {
             const double *nrm = sim->wind_normal + 3 * i;
             cs_axpy(c * sim->wind_area[i] * cs_dot(nrm, sim->def.wind.velocity), nrm,
                     sim->force + 3 * i);
@@ -443,20 +463,42 @@ static void explicit_forces(cs_sim *sim, const double *x)
 /* rhs = M v_start + h force */
 static void momentum_rhs(cs_sim *sim, const double *v_start)
 {
-    for (int i = 0; i < sim->n; i++)
+    CS_FOR_OWNED(sim->par, i)
         for (int d = 0; d < 3; d++)
             sim->rhs[3 * i + d] = sim->mass[i] * v_start[3 * i + d] + sim->h * sim->force[3 * i + d];
 }
 
+/* Copies 3 doubles per particle over the given ranges. */
+static void copy_ranges(const int *ranges, int nranges, double *dst, const double *src)
+{
+    for (int r = 0; r < nranges; r++)
+        memcpy(dst + 3 * ranges[2 * r], src + 3 * ranges[2 * r],
+               sizeof(double) * 3 * (size_t)(ranges[2 * r + 1] - ranges[2 * r]));
+}
+
+/* True on every rank when every owned particle is finite everywhere. */
+static bool state_finite(cs_sim *sim)
+{
+    double bad = 0;
+    cs_par_begin(sim->par, CS_STAGE_VELOCITY_FULL); /* B.6's result checked */
+    CS_FOR_OWNED(sim->par, i)
+        for (int d = 0; d < 3; d++)
+            if (!isfinite(sim->x[3 * i + d]) || !isfinite(sim->v[3 * i + d]))
+                bad = 1;
+    cs_par_max(sim->par, &bad, 1);
+    return bad == 0;
+}
+
 int cs_sim_step(cs_sim *sim, double dt)
 {
-    int n = sim->n, n3 = 3 * n;
+    cs_par *par = sim->par;
     const cs_plan *plan = &sim->plan;
     bool bodies = cs_plan_has(plan, CS_STAGE_BODY_COLLISION);
     double t1 = sim->t + dt;
     sim->h = 0.5 * dt;
-    memcpy(sim->x_prev, sim->x, sizeof(double) * (size_t)n3);
-    for (int i = 0; i < n; i++)
+    /* x (owned and ghosts) is current here; v only where owned */
+    copy_ranges(par->local, par->nlocal, sim->x_prev, sim->x);
+    CS_FOR_OWNED(par, i)
         sim->mode[i] = sim->is_free[i] ? CS_FREE : CS_FIXED;
 
     if (sim->nscripts > 0) {
@@ -474,8 +516,8 @@ int cs_sim_step(cs_sim *sim, double dt)
      * contact (constraining it would make cloth stick to bodies). Scripted
      * particles move straight to their targets. */
     STAGE_BEGIN(sim, CS_STAGE_VELOCITY_HALF);
-    memcpy(sim->v0, sim->v, sizeof(double) * (size_t)n3);
-    for (int i = 0; i < n; i++)
+    copy_ranges(par->own, par->nown, sim->v0, sim->v);
+    CS_FOR_OWNED(par, i)
         if (!sim->is_free[i])
             for (int d = 0; d < 3; d++)
                 sim->v0[3 * i + d] = (sim->script_x[3 * i + d] - sim->x[3 * i + d]) / dt;
@@ -494,11 +536,14 @@ int cs_sim_step(cs_sim *sim, double dt)
 
     /* B.3 */
     STAGE_BEGIN(sim, CS_STAGE_POSITION_UPDATE);
-    for (int k = 0; k < n3; k++)
-        sim->x[k] = sim->x_prev[k] + dt * sim->v_half[k];
-    for (int i = 0; i < n; i++) /* exact targets, free of round-off */
-        if (!sim->is_free[i])
+    CS_FOR_OWNED(par, i) {
+        if (sim->is_free[i]) {
+            for (int d = 0; d < 3; d++)
+                sim->x[3 * i + d] = sim->x_prev[3 * i + d] + dt * sim->v_half[3 * i + d];
+        } else { /* exact targets, free of round-off */
             memcpy(sim->x + 3 * i, sim->script_x + 3 * i, 3 * sizeof(double));
+        }
+    }
     STAGE_END(sim, CS_STAGE_POSITION_UPDATE);
 
     /* B.4 */
@@ -507,7 +552,13 @@ int cs_sim_step(cs_sim *sim, double dt)
         cs_body_collide(sim, dt);
         STAGE_END(sim, CS_STAGE_BODY_COLLISION);
     } else {
-        memcpy(sim->v_star, sim->v, sizeof(double) * (size_t)n3);
+        copy_ranges(par->own, par->nown, sim->v_star, sim->v);
+    }
+    { /* the ghosts' new positions, for the forces at x^(n+1/2): B.3's messages */
+        double t0 = now();
+        cs_par_begin(par, CS_STAGE_POSITION_UPDATE);
+        cs_halo_forward(par, &par->ghosts, sim->x, 3);
+        sim->timing[CS_STAGE_POSITION_UPDATE].seconds += now() - t0;
     }
 
     /* B.5 and B.6: v^(n+1/2) = v*^n + dt/2 a(x^(n+1/2), v^(n+1/2)) with the
@@ -516,31 +567,34 @@ int cs_sim_step(cs_sim *sim, double dt)
      * v_NP: the same forces, damping evaluated at the projected solution,
      * applied without projection, so B.7 sees the normal force. */
     STAGE_BEGIN(sim, CS_STAGE_VELOCITY_FULL);
-    for (int i = 0; i < n; i++)
+    CS_FOR_OWNED(par, i)
         if (!sim->is_free[i])
             memcpy(sim->v_star + 3 * i, sim->v0 + 3 * i, 3 * sizeof(double));
-    for (int k = 0; k < n3; k++)
-        sim->v_half[k] = 0.5 * (sim->x_prev[k] + sim->x[k]); /* x^(n+1/2), reusing v_half */
+    CS_FOR_LOCAL(par, i) /* x^(n+1/2), reusing v_half */
+        for (int d = 0; d < 3; d++)
+            sim->v_half[3 * i + d] = 0.5 * (sim->x_prev[3 * i + d] + sim->x[3 * i + d]);
     explicit_forces(sim, sim->v_half);
     cs_springs_prepare(&sim->springs, sim->v_half);
     momentum_rhs(sim, sim->v_star);
     double *v_p = sim->v0; /* v0 is free again */
-    memcpy(sim->cg.b, sim->v_star, sizeof(double) * (size_t)n3);
+    copy_ranges(par->own, par->nown, sim->cg.b, sim->v_star);
     sim->cg_iterations += cs_cg_solve(sim, sim->cg.b, sim->rhs, v_p);
     if (bodies && sim->def.friction_method == CS_FRICTION_IMPROVED) {
-        memcpy(sim->v_next, sim->force, sizeof(double) * (size_t)n3);
+        copy_ranges(par->local, par->nlocal, sim->v_next, sim->force);
+        cs_halo_forward(par, &par->ghosts, v_p, 3);
         cs_damping_apply(sim, v_p, sim->v_next); /* F_i + F_d v_P */
-        for (int i = 0; i < n; i++)
+        CS_FOR_OWNED(par, i)
             for (int d = 0; d < 3; d++) {
                 int k = 3 * i + d;
                 double v_np = sim->v_star[k] + sim->h / sim->mass[i] * sim->v_next[k];
                 sim->v_next[k] = 2.0 * v_np - sim->v_star[k];
             }
     } else {
-        for (int k = 0; k < n3; k++)
-            sim->v_next[k] = 2.0 * v_p[k] - sim->v_star[k];
+        CS_FOR_OWNED(par, i)
+            for (int d = 0; d < 3; d++)
+                sim->v_next[3 * i + d] = 2.0 * v_p[3 * i + d] - sim->v_star[3 * i + d];
     }
-    for (int i = 0; i < n; i++)
+    CS_FOR_OWNED(par, i)
         if (!sim->is_free[i])
             memcpy(sim->v_next + 3 * i, sim->script_v + 3 * i, 3 * sizeof(double));
     STAGE_END(sim, CS_STAGE_VELOCITY_FULL);
@@ -557,21 +611,9 @@ int cs_sim_step(cs_sim *sim, double dt)
         cs_selfcol_repulse(sim, sim->x, sim->v_next, dt, false);
         STAGE_END(sim, CS_STAGE_SELF_FRICTION);
     }
-    memcpy(sim->v, sim->v_next, sizeof(double) * (size_t)n3);
+    copy_ranges(par->own, par->nown, sim->v, sim->v_next);
     sim->t = t1;
-
-    for (int k = 0; k < n3; k++)
-        if (!isfinite(sim->x[k]) || !isfinite(sim->v[k]))
-            return CS_ERR_UNSTABLE;
-    return CS_OK;
-}
-
-static bool state_finite(const cs_sim *sim)
-{
-    for (int k = 0; k < 3 * sim->n; k++)
-        if (!isfinite(sim->x[k]) || !isfinite(sim->v[k]))
-            return false;
-    return true;
+    return state_finite(sim) ? CS_OK : CS_ERR_UNSTABLE;
 }
 
 /* One outer collision step of k time steps (Section 4): step A, k steps of
@@ -640,32 +682,45 @@ int cs_sim_advance_frame(cs_sim *sim, cs_frame_stats *stats)
         status = outer_step(sim, chunk);
         s += chunk;
     }
+    /* rank 0 gets the whole state: frames are written once */
+    cs_par_begin(sim->par, CS_STAGE_POSITION_UPDATE);
+    cs_par_gather_root(sim->par, sim->x, 3);
+    cs_par_gather_root(sim->par, sim->v, 3);
     long intersections = -1;
     if (status == CS_OK && cs_plan_has(&sim->plan, CS_STAGE_VERIFY)) {
         STAGE_BEGIN(sim, CS_STAGE_VERIFY);
-        intersections = cs_sim_count_intersections(sim);
+        if (sim->par->rank == 0)
+            intersections = cs_sim_count_intersections(sim);
         STAGE_END(sim, CS_STAGE_VERIFY);
     }
+    /* counters each rank kept for its own particles and pairs */
+    cs_selfcol_stats self = {0};
+    if (sim->selfcol)
+        self = sim->selfcol->stats;
+    long sums[5] = {sim->contacts - contacts0, self.repulsion_pairs - self0.repulsion_pairs,
+                    self.repulsions - self0.repulsions, self.collisions - self0.collisions, 0};
+    cs_par_begin(sim->par, CS_STAGE_VELOCITY_FULL);
+    cs_par_sum_long(sim->par, sums, 4);
+    double max_speed = 0;
+    CS_FOR_OWNED(sim->par, i)
+        max_speed = fmax(max_speed, cs_norm(sim->v + 3 * i));
+    cs_par_max(sim->par, &max_speed, 1);
+    cs_par_report(sim->par, sim->timing, sim->timing_all, sim->comm_all, sim->rank_comm);
     if (stats) {
         memset(stats, 0, sizeof *stats);
         stats->steps = steps;
         stats->dt = sim->dt;
         stats->cg_iterations = sim->cg_iterations - cg0;
-        stats->body_contacts = sim->contacts - contacts0;
-        for (int i = 0; i < sim->n; i++) {
-            double s = cs_norm(sim->v + 3 * i);
-            if (s > stats->max_speed)
-                stats->max_speed = s;
-        }
-        if (sim->selfcol) {
-            const cs_selfcol_stats *now = &sim->selfcol->stats;
-            stats->repulsion_pairs = now->repulsion_pairs - self0.repulsion_pairs;
-            stats->repulsions = now->repulsions - self0.repulsions;
-            stats->collisions = now->collisions - self0.collisions;
-            stats->collision_passes = now->passes - self0.passes;
-            stats->impact_zones = now->zones - self0.zones;
-            stats->max_zone_size = now->max_zone;
-            stats->rewinds = now->rewinds - self0.rewinds;
+        stats->body_contacts = sums[0];
+        stats->max_speed = max_speed;
+        if (sim->selfcol) { /* passes, zones and rewinds are the same on every rank */
+            stats->repulsion_pairs = sums[1];
+            stats->repulsions = sums[2];
+            stats->collisions = sums[3];
+            stats->collision_passes = self.passes - self0.passes;
+            stats->impact_zones = self.zones - self0.zones;
+            stats->max_zone_size = self.max_zone;
+            stats->rewinds = self.rewinds - self0.rewinds;
         }
         stats->intersections = intersections;
     }
@@ -705,7 +760,18 @@ int cs_sim_cloth_offset(const cs_sim *sim, int c) { return sim->cloths[c].offset
 const cs_trimesh *cs_sim_cloth_mesh(const cs_sim *sim, int c) { return sim->cloths[c].mesh; }
 const char *cs_sim_cloth_name(const cs_sim *sim, int c) { return sim->cloths[c].name; }
 const cs_plan *cs_sim_plan(const cs_sim *sim) { return &sim->plan; }
-const cs_stage_timing *cs_sim_stage_timing(const cs_sim *sim) { return sim->timing; }
+const cs_stage_timing *cs_sim_stage_timing(const cs_sim *sim)
+{
+    return sim->par->size > 1 ? sim->timing_all : sim->timing;
+}
+const cs_comm_stats *cs_sim_stage_comm(const cs_sim *sim)
+{
+    return sim->par->size > 1 ? sim->comm_all : sim->par->stats;
+}
+int cs_sim_agree(cs_sim *sim, int value) { return cs_par_bcast_int(sim->par, value); }
+int cs_sim_rank(const cs_sim *sim) { return sim->par->rank; }
+int cs_sim_ranks(const cs_sim *sim) { return sim->par->size; }
+const cs_comm_stats *cs_sim_rank_comm(const cs_sim *sim) { return sim->rank_comm; }
 size_t cs_sim_stage_bytes(const cs_sim *sim, cs_stage stage)
 {
     return (unsigned)stage < CS_STAGE_COUNT ? sim->stage_bytes[stage] : 0;

@@ -13,6 +13,8 @@
 #include <stdbool.h>
 #include <stddef.h>
 
+#include <mpi.h>
+
 #ifdef __cplusplus
 extern "C" {
 #endif
@@ -228,6 +230,11 @@ typedef struct cs_sim_def {
     const cs_cloth_def *cloths;
     int nbodies;
     const cs_body_def *bodies;
+    /* Section 7: the ranks that share the simulation (MPI_COMM_WORLD by
+     * default). Every rank makes the same calls with the same definition.
+     * Without MPI initialised, or with MPI_COMM_NULL, it is one rank and
+     * makes no MPI call. */
+    MPI_Comm comm;
 } cs_sim_def;
 
 cs_sim_def cs_default_sim_def(void);
@@ -269,6 +276,13 @@ typedef struct cs_stage_timing {
     long calls;
 } cs_stage_timing;
 
+/* Messages a stage sent: time spent in communication calls (included in
+ * the stage's seconds), bytes and messages sent. */
+typedef struct cs_comm_stats {
+    double seconds;
+    long bytes, messages;
+} cs_comm_stats;
+
 /* Counters for one frame. */
 typedef struct cs_frame_stats {
     int steps;
@@ -295,8 +309,24 @@ typedef struct cs_sim cs_sim;
 cs_sim *cs_sim_create(const cs_sim_def *def, char *err, size_t errlen);
 void cs_sim_destroy(cs_sim *sim);
 
-/* Advances one frame (1/fps seconds). Returns CS_OK or CS_ERR_UNSTABLE. */
+/* Advances one frame (1/fps seconds). Returns CS_OK or CS_ERR_UNSTABLE,
+ * the same on every rank. A collective call: afterwards rank 0 holds every
+ * particle's position and velocity (other ranks their own and their
+ * ghosts'), and the frame's counters summed over ranks. */
 int cs_sim_advance_frame(cs_sim *sim, cs_frame_stats *stats);
+
+/* Rank 0's value, on every rank (a collective): how the ranks agree to go
+ * on or stop after rank 0 has written a frame. */
+int cs_sim_agree(cs_sim *sim, int value);
+
+/* MPI for a command (Section 7). Initialises MPI when a launcher (mpirun,
+ * srun) started the process, or when CLOTHSIM_MPI=1; a plain run stays one
+ * rank without it (no singleton start-up cost) and runs the same code.
+ * Returns whether MPI is initialised. */
+bool cs_parallel_init(int *argc, char ***argv);
+void cs_parallel_finalize(void);
+/* This process's rank in MPI_COMM_WORLD; 0 without MPI. */
+int cs_parallel_rank(void);
 
 /* Advances by exactly one time step of the integrator (for tests). */
 int cs_sim_step(cs_sim *sim, double dt);
@@ -320,7 +350,16 @@ const cs_trimesh *cs_sim_cloth_mesh(const cs_sim *sim, int c);
 const char *cs_sim_cloth_name(const cs_sim *sim, int c);
 
 const cs_plan *cs_sim_plan(const cs_sim *sim);
-const cs_stage_timing *cs_sim_stage_timing(const cs_sim *sim); /* CS_STAGE_COUNT entries */
+/* CS_STAGE_COUNT entries. With several ranks, after cs_sim_advance_frame
+ * and on rank 0 only: seconds are the slowest rank's, the communication
+ * seconds the largest and bytes and messages the sum over ranks. */
+const cs_stage_timing *cs_sim_stage_timing(const cs_sim *sim);
+const cs_comm_stats *cs_sim_stage_comm(const cs_sim *sim);
+/* This rank and the number of ranks; per rank (cs_sim_ranks entries, on
+ * rank 0 after a frame) the communication totals of every stage. */
+int cs_sim_rank(const cs_sim *sim);
+int cs_sim_ranks(const cs_sim *sim);
+const cs_comm_stats *cs_sim_rank_comm(const cs_sim *sim);
 /* Bytes the simulation allocated for a stage's own data (0 if absent). */
 size_t cs_sim_stage_bytes(const cs_sim *sim, cs_stage stage);
 

@@ -207,3 +207,22 @@ double cs_springs_stiffness_bound(const cs_springs *s, const double *mass,
     free(sum);
     return bound;
 }
+
+void cs_springs_keep_touching(cs_springs *s, const int *owner, int rank)
+{
+    int kept = 0, kept_edge = 0;
+    for (int k = 0; k < s->n; k++) {
+        int i = s->ends[2 * k], j = s->ends[2 * k + 1];
+        if (owner[i] != rank && owner[j] != rank)
+            continue;
+        s->ends[2 * kept] = i;
+        s->ends[2 * kept + 1] = j;
+        s->rest_length[kept] = s->rest_length[k];
+        s->stiffness[kept] = s->stiffness[k];
+        s->damping[kept] = s->damping[k];
+        kept_edge += k < s->nedge;
+        kept++;
+    }
+    s->n = kept;
+    s->nedge = kept_edge;
+}
