@@ -8,3 +8,5 @@ cmake --build build -j"$(nproc)"
 build/bench_accuracy_time gallery
 gallery/render.sh build
 gallery/selfcol.sh build
+# strong scaling at 1 and 2 ranks (more where the machine has the cores)
+bench/scaling.sh build 1 2
