@@ -71,6 +71,10 @@ struct cs_sim {
     long cg_iterations, contacts;
 };
 
+/* mesh.c: sorts n (a, b) integer pairs lexicographically and drops the
+ * repeats; returns how many are left (edges of a mesh, halo entries). */
+int cs_sort_unique_pairs(int *pairs, int n);
+
 /* cg.c: solves P (M - h D) P z = P (rhs - (M - h D) v0) for v = v0 + z,
  * where P projects out fixed velocities and contact normals, over all
  * ranks (v0's ghosts are refreshed first; v is written where owned).

@@ -1,6 +1,7 @@
 /* mesh.c: triangle meshes and the generated rectangle grid. */
 #include <stdlib.h>
 
+#include "sim/internal.h"
 #include "sim/sim.h"
 #include "sim/vec3.h"
 
@@ -69,4 +70,26 @@ cs_trimesh *cs_trimesh_create_grid(const double size[2], const int res[2],
             }
         }
     return m;
+}
+
+static int cmp_int2(const void *a, const void *b)
+{
+    const int *p = a, *q = b;
+    if (p[0] != q[0])
+        return p[0] < q[0] ? -1 : 1;
+    return (p[1] > q[1]) - (p[1] < q[1]);
+}
+
+int cs_sort_unique_pairs(int *pairs, int n)
+{
+    qsort(pairs, (size_t)n, 2 * sizeof *pairs, cmp_int2);
+    int u = 0;
+    for (int k = 0; k < n; k++)
+        if (u == 0 || pairs[2 * k] != pairs[2 * (u - 1)] ||
+            pairs[2 * k + 1] != pairs[2 * (u - 1) + 1]) {
+            pairs[2 * u] = pairs[2 * k];
+            pairs[2 * u + 1] = pairs[2 * k + 1];
+            u++;
+        }
+    return u;
 }

@@ -2,6 +2,8 @@
  * one file of the project that calls MPI. */
 #include "sim/par.h"
 
+#include "sim/internal.h"
+
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -108,14 +110,6 @@ static int *ranges_of(const unsigned char *mark, int n, int *nranges)
     return r;
 }
 
-static int cmp_int2(const void *a, const void *b)
-{
-    const int *p = a, *q = b;
-    if (p[0] != q[0])
-        return p[0] < q[0] ? -1 : 1;
-    return (p[1] > q[1]) - (p[1] < q[1]);
-}
-
 /* Builds h from (other rank, particle) entries for what this rank sends
  * and what it receives, each sorted and made unique here. */
 static int halo_build(const cs_par *p, int nsend, int *send, int nrecv, int *recv, cs_halo *h)
@@ -123,16 +117,7 @@ static int halo_build(const cs_par *p, int nsend, int *send, int nrecv, int *rec
     memset(h, 0, sizeof *h);
     int *lists[2] = {send, recv}, counts[2] = {nsend, nrecv};
     for (int s = 0; s < 2; s++) {
-        qsort(lists[s], (size_t)counts[s], 2 * sizeof(int), cmp_int2);
-        int u = 0;
-        for (int k = 0; k < counts[s]; k++)
-            if (u == 0 || lists[s][2 * k] != lists[s][2 * (u - 1)] ||
-                lists[s][2 * k + 1] != lists[s][2 * (u - 1) + 1]) {
-                lists[s][2 * u] = lists[s][2 * k];
-                lists[s][2 * u + 1] = lists[s][2 * k + 1];
-                u++;
-            }
-        counts[s] = u;
+        counts[s] = cs_sort_unique_pairs(lists[s], counts[s]);
     }
     int *per_rank = calloc((size_t)p->size * 2 + 2, sizeof *per_rank);
     if (!per_rank)

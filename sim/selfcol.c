@@ -12,14 +12,6 @@
 
 /* ------------------------------------------------------------ topology */
 
-static int cmp_edge(const void *a, const void *b)
-{
-    const int *p = a, *q = b;
-    if (p[0] != q[0])
-        return p[0] < q[0] ? -1 : 1;
-    return (p[1] > q[1]) - (p[1] < q[1]);
-}
-
 static int pair_push(cs_pair_list *l, const int v[4], const double *s0)
 {
     if (l->n == l->capacity) {
@@ -85,14 +77,7 @@ cs_selfcol *cs_selfcol_create(const cs_sim *sim)
             e[6 * t + 2 * k] = a < b ? a : b;
             e[6 * t + 2 * k + 1] = a < b ? b : a;
         }
-    qsort(e, 3 * (size_t)nt, 2 * sizeof *e, cmp_edge);
-    int ne = 0;
-    for (int k = 0; k < 3 * nt; k++)
-        if (ne == 0 || e[2 * k] != e[2 * (ne - 1)] || e[2 * k + 1] != e[2 * (ne - 1) + 1]) {
-            e[2 * ne] = e[2 * k];
-            e[2 * ne + 1] = e[2 * k + 1];
-            ne++;
-        }
+    int ne = cs_sort_unique_pairs(e, 3 * nt);
     sc->edge = e;
     sc->ne = ne;
     sc->ring_start = calloc((size_t)n + 2, sizeof *sc->ring_start);

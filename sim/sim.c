@@ -697,8 +697,8 @@ int cs_sim_advance_frame(cs_sim *sim, cs_frame_stats *stats)
     cs_selfcol_stats self = {0};
     if (sim->selfcol)
         self = sim->selfcol->stats;
-    long sums[5] = {sim->contacts - contacts0, self.repulsion_pairs - self0.repulsion_pairs,
-                    self.repulsions - self0.repulsions, self.collisions - self0.collisions, 0};
+    long sums[4] = {sim->contacts - contacts0, self.repulsion_pairs - self0.repulsion_pairs,
+                    self.repulsions - self0.repulsions, self.collisions - self0.collisions};
     cs_par_begin(sim->par, CS_STAGE_VELOCITY_FULL);
     cs_par_sum_long(sim->par, sums, 4);
     double max_speed = 0;
