@@ -226,7 +226,7 @@ static double body_cost(const cs_body_def *bodies, int nbodies)
 
 int main(int argc, char **argv)
 {
-    const char *assets = argc > 1 ? argv[1] : CS_SOURCE_DIR "/../shared/assets";
+    const char *assets = argc > 1 ? argv[1] : CS_SOURCE_DIR "/assets";
     cs_trimesh *sphere = uv_sphere(1.0, 100000);
 
     printf("## Conversion (median of 3; band 3 voxels; peak RSS of the converting process)\n\n");

@@ -3,14 +3,14 @@
 # command line (issue 4): `clothsim mesh-info`, `clothsim levelset`, their
 # errors (status 2, one clear line), and the shipped bunny scene, whose
 # frames must stay clear of the body (summary.json's body_penetration_max).
-# The meshes are shared/assets beside the repository; without them this
+# The meshes are in the repository's assets/ folder; without them this
 # test fails.
 set -eu
 
 NAME=cli_mesh
 . "$2/tests/harness.sh"
-ASSETS="$2/../shared/assets"
-[ -r "$ASSETS/ico4.obj" ] || fail "shared/assets is missing (looked in $ASSETS)"
+ASSETS="$2/assets"
+[ -r "$ASSETS/ico4.obj" ] || fail "the repository's assets/ folder is missing (looked in $ASSETS)"
 
 # --- mesh-info: what import sees
 run 0 mesh-info "$ASSETS/human.dae"

@@ -12,7 +12,7 @@
  *   replaced when the mesh or the voxel size change;
  * - SHA-256 against FIPS 180-4's test vectors.
  *
- * The meshes come from shared/assets beside the repository (CS_ASSETS_DIR);
+ * The meshes come from the repository's assets/ folder (CS_ASSETS_DIR);
  * without them the tests fail, they do not skip.
  */
 #include <setjmp.h>
@@ -32,14 +32,13 @@
 #include "import/sha256.h"
 
 #ifndef CS_ASSETS_DIR
-#error "CS_ASSETS_DIR must name shared/assets (tests/CMakeLists.txt defines it)"
+#error "CS_ASSETS_DIR must name the repository's assets/ folder (tests/CMakeLists.txt defines it)"
 #endif
 
 static void require_asset(const char *path)
 {
     if (access(path, R_OK) != 0) {
-        print_error("missing test asset %s: shared/assets must be checked out beside the "
-                    "repository (../shared/assets)\n",
+        print_error("missing test asset %s: the repository's assets/ folder is incomplete\n",
                     path);
         fail();
     }

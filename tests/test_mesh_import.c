@@ -1,10 +1,10 @@
 /* test_mesh_import.c: mesh files through assimp (import/mesh_import.c):
- * every format of the issue on the real meshes of shared/assets, checked
- * against the counts of its MANIFEST.md; node selection and merging, units
- * and placement; repairs and topology; hole closing; and bad input, which
- * must be a clear message, never a crash or an empty mesh.
+ * every format of the issue on the real meshes of the repository's assets/
+ * folder, checked against the counts of its MANIFEST.md; node selection
+ * and merging, units and placement; repairs and topology; hole closing; and
+ * bad input, which must be a clear message, never a crash or an empty mesh.
  *
- * The meshes come from shared/assets beside the repository (CS_ASSETS_DIR);
+ * The meshes come from the repository's assets/ folder (CS_ASSETS_DIR);
  * without them the tests fail, they do not skip. */
 #include <setjmp.h>
 #include <stdarg.h>
@@ -21,7 +21,7 @@
 #include "import/import.h"
 
 #ifndef CS_ASSETS_DIR
-#error "CS_ASSETS_DIR must name shared/assets (tests/CMakeLists.txt defines it)"
+#error "CS_ASSETS_DIR must name the repository's assets/ folder (tests/CMakeLists.txt defines it)"
 #endif
 
 static char tmpdir[256];
@@ -45,8 +45,7 @@ static void asset(char *out, size_t len, const char *name)
 {
     snprintf(out, len, "%s/%s", CS_ASSETS_DIR, name);
     if (access(out, R_OK) != 0) {
-        print_error("missing test asset %s: shared/assets must be checked out beside the "
-                    "repository (../shared/assets)\n",
+        print_error("missing test asset %s: the repository's assets/ folder is incomplete\n",
                     out);
         fail();
     }

@@ -19,7 +19,7 @@
 #include "import/import.h"
 
 #ifndef CS_ASSETS_DIR
-#error "CS_ASSETS_DIR must name shared/assets (tests/CMakeLists.txt defines it)"
+#error "CS_ASSETS_DIR must name the repository's assets/ folder (tests/CMakeLists.txt defines it)"
 #endif
 #define ASSET(name) CS_ASSETS_DIR "/" name
 
@@ -32,8 +32,8 @@ static int setup(void **state)
     if (!mkdtemp(tmpdir))
         return -1;
     if (access(ASSET("ico4.obj"), R_OK) != 0) {
-        print_error("missing test assets in %s: shared/assets must be checked out beside the "
-                    "repository\n",
+        print_error("missing test assets in %s: the repository's assets/ folder is "
+                    "incomplete\n",
                     CS_ASSETS_DIR);
         return -1;
     }
