@@ -49,6 +49,7 @@ typedef struct run_options {
     bool quiet;
     const char *render;       /* --render ENGINE, --size, --samples; NULL: none */
     const char *render_size, *render_samples;
+    int threads;              /* --threads N; 0: one per core (see cs_parallel_set_threads) */
 } run_options;
 
 void cs_run_help(FILE *out)
@@ -79,6 +80,10 @@ void cs_run_help(FILE *out)
         "                       'clothsim render --help' for rendering after a run\n"
         "      --size WxH       with --render: image size (default 640x480)\n"
         "      --samples N      with --render: samples per pixel (default 16; preview 4)\n"
+        "      --threads N      OpenMP threads per rank (default: OMP_NUM_THREADS, else\n"
+        "                       one per core the process may use, shared among the\n"
+        "                       ranks mpirun started on the machine); the frames are\n"
+        "                       the same bits at every thread count\n"
         "  -q, --quiet          no progress display\n"
         "  -h, --help           show this help\n"
         "\n"
@@ -100,11 +105,12 @@ static void usage_error(const char *fmt, const char *arg)
     fprintf(stderr, "clothsim run: ");
     fprintf(stderr, fmt, arg);
     fprintf(stderr, "\nusage: clothsim run SCENE [-o DIR] [--set KEY=VALUE]... [--format ply|obj|glb]\n"
-                    "                    [--frames N] [--plan] [--quiet]\n"
+                    "                    [--frames N] [--threads N] [--plan] [--quiet]\n"
                     "'clothsim run --help' explains every option.\n");
 }
 
-enum { OPT_SET = 256, OPT_FORMAT, OPT_FRAMES, OPT_PLAN, OPT_RENDER, OPT_SIZE, OPT_SAMPLES };
+enum { OPT_SET = 256, OPT_FORMAT, OPT_FRAMES, OPT_PLAN, OPT_RENDER, OPT_SIZE, OPT_SAMPLES,
+       OPT_THREADS };
 
 /* Returns -1 to go on, else an exit status. */
 static int parse_options(int argc, char **argv, run_options *o)
@@ -118,6 +124,7 @@ static int parse_options(int argc, char **argv, run_options *o)
         {"render", required_argument, NULL, OPT_RENDER},
         {"size", required_argument, NULL, OPT_SIZE},
         {"samples", required_argument, NULL, OPT_SAMPLES},
+        {"threads", required_argument, NULL, OPT_THREADS},
         {"quiet", no_argument, NULL, 'q'},
         {"help", no_argument, NULL, 'h'},
         {NULL, 0, NULL, 0},
@@ -166,6 +173,17 @@ static int parse_options(int argc, char **argv, run_options *o)
                 return CS_EXIT_USAGE;
             }
             frames = optarg;
+            break;
+        }
+        case OPT_THREADS: {
+            char *end;
+            errno = 0;
+            long n = strtol(optarg, &end, 10);
+            if (end == optarg || *end || errno || n < 1 || n > 4096) {
+                usage_error("--threads: '%s' is not a whole number from 1 to 4096", optarg);
+                return CS_EXIT_USAGE;
+            }
+            o->threads = (int)n;
             break;
         }
         case OPT_PLAN:
@@ -416,6 +434,8 @@ static void print_plan(const cs_scene *scene, const cs_sim *sim, FILE *out)
     double dt = cs_sim_dt(sim);
     fprintf(out, "step size %.6g s (stability limit %.6g s): %d steps per frame at %g fps\n",
             dt, cs_sim_stable_dt(sim), steps_per_frame(scene->def.fps, dt), scene->def.fps);
+    fprintf(out, "  (2/omega_max, omega_max^2 by Lanczos iterations; Gershgorin's bound would "
+            "give %.6g s)\n", cs_sim_gershgorin_dt(sim));
     fprintf(out, "%d frames after the initial one: %.6g s of simulated time; %d particles\n",
             scene->frames, scene->def.fps > 0 ? scene->frames / scene->def.fps : 0.0,
             cs_sim_particle_count(sim));
@@ -605,6 +625,7 @@ int cs_run_main(int argc, char **argv)
     /* every rank loads the scene: the same file gives the same result, so
      * only rank 0 speaks */
     bool root = cs_parallel_rank() == 0;
+    cs_parallel_set_threads(o.threads);
     int rc = cs_scene_load(o.scene_path, o.noverrides, (const char *const *)o.overrides, &scene,
                            err, sizeof err);
     if (rc != CS_IMPORT_OK) {
@@ -683,6 +704,7 @@ int cs_run_main(int argc, char **argv)
     s->dt = cs_sim_dt(r.sim);
     s->steps_per_frame = steps_per_frame(scene->def.fps, s->dt);
     s->particles = cs_sim_particle_count(r.sim);
+    s->springs = cs_sim_spring_count(r.sim);
     s->triangles = triangles;
     s->plan = *cs_sim_plan(r.sim);
 

@@ -45,6 +45,7 @@ void cs_summary_take_timing(cs_summary *s, const cs_sim *sim)
         s->comm[i] = c ? c[i] : (cs_comm_stats){0, 0, 0};
     }
     s->ranks = cs_sim_ranks(sim);
+    s->threads = cs_parallel_threads();
     const cs_comm_stats *per_rank = cs_sim_rank_comm(sim);
     for (int r = 0; r < s->ranks && r < CS_SUMMARY_MAX_RANKS; r++)
         s->rank_comm[r] = per_rank[r];
@@ -121,7 +122,9 @@ static cJSON *build_json(const cs_summary *s, builder *b)
     add_num(b, root, "steps_per_frame", s->steps_per_frame);
     add_num(b, root, "particles", s->particles);
     add_num(b, root, "triangles", s->triangles);
+    add_num(b, root, "springs", s->springs);
     add_num(b, root, "ranks", s->ranks > 0 ? s->ranks : 1);
+    add_num(b, root, "threads", s->threads > 0 ? s->threads : 1);
 
     cJSON *plan = add_array(b, root, "plan");
     for (int i = 0; i < s->plan.nstages; i++)
@@ -273,6 +276,8 @@ void cs_summary_print_table(const cs_summary *s, FILE *out)
     if (s->ranks > 1)
         fprintf(out, "%d ranks; summary.json lists the bytes and messages each sent\n",
                 s->ranks);
+    if (s->threads > 1)
+        fprintf(out, "%d threads per rank\n", s->threads);
 
     int simulated = s->nframes;
     fprintf(out, "\nwall time %.3f s (simulation %.3f s, output %.3f s)\n",

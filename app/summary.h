@@ -43,12 +43,13 @@ typedef struct cs_summary {
     int frames_written;              /* files on disk, frame 0 included */
     double fps, dt;
     int steps_per_frame;
-    int particles, triangles;
+    int particles, triangles, springs;
     cs_plan plan;
     cs_stage_timing timing[CS_STAGE_COUNT];
     size_t bytes[CS_STAGE_COUNT];
     cs_comm_stats comm[CS_STAGE_COUNT];   /* messages per stage, all ranks */
     int ranks;
+    int threads;                          /* OpenMP threads per rank */
     cs_comm_stats rank_comm[CS_SUMMARY_MAX_RANKS]; /* sent by each rank */
     double total_seconds;            /* wall time of the whole command so far */
     double simulation_seconds;       /* of which in cs_sim_advance_frame */

@@ -1,162 +1,228 @@
 /* cg.c: matrix-free preconditioned conjugate gradient for the implicit
  * damping solves (steps B.1 and B.5), with the contact projection P of
- * Section 6 applied as a filter (the modified PCG of Baraff and Witkin). */
+ * Section 6 applied as a filter (the modified PCG of Baraff and Witkin).
+ *
+ * Threads (OpenMP) share the owned particles in fixed blocks of
+ * CS_BLOCK; each loop does all of a particle's work in one pass, and an
+ * inner product is summed block by block in block order, so the result is
+ * the same bits at every thread count. */
 #include <math.h>
 #include <string.h>
 
 #include "sim/internal.h"
 #include "sim/vec3.h"
 
+static int block_count(const cs_par *par) { return (par->nowned + CS_BLOCK - 1) / CS_BLOCK; }
+
+/* acc += the implicit part of the linear normal drag on particle i */
+static inline void wind_row(const cs_sim *sim, int i, const double *v, double acc[3])
+{
+    const double *nrm = sim->wind_normal + 3 * i;
+    cs_axpy(-sim->def.wind.drag * sim->wind_area[i] * cs_dot(nrm, v + 3 * i), nrm, acc);
+}
+
+/* out_i = ((M - h D) v)_i for row r (particle i) */
+static inline void system_row(const cs_sim *sim, int r, int i, const double *v, double out[3])
+{
+    double acc[3] = {0, 0, 0};
+    cs_springs_damping_row(&sim->springs, r, v, acc);
+    if (sim->wind_normal)
+        wind_row(sim, i, v, acc);
+    for (int d = 0; d < 3; d++)
+        out[d] = sim->mass[i] * v[3 * i + d] - sim->h * acc[d];
+}
+
+/* P: fixed velocities and contact normals projected out */
+static inline void project_row(const cs_sim *sim, int i, double a[3])
+{
+    if (sim->mode[i] == CS_FIXED) {
+        a[0] = a[1] = a[2] = 0;
+    } else if (sim->mode[i] == CS_CONTACT) {
+        const double *N = sim->contact_normal + 3 * i;
+        cs_axpy(-cs_dot(a, N), N, a);
+    }
+}
+
 void cs_damping_apply(const cs_sim *sim, const double *v, double *out)
 {
-    cs_springs_add_damping(&sim->springs, v, out);
-    if (sim->wind_normal) { /* implicit part of the linear normal drag */
-        double c = sim->def.wind.drag;
-        CS_FOR_OWNED(sim->par, i) {
-            const double *nrm = sim->wind_normal + 3 * i;
-            cs_axpy(-c * sim->wind_area[i] * cs_dot(nrm, v + 3 * i), nrm, out + 3 * i);
-        }
+    const int *own = cs_par_owned(sim->par);
+#pragma omp parallel for schedule(static)
+    for (int r = 0; r < sim->par->nowned; r++) {
+        int i = own[r];
+        double acc[3] = {out[3 * i], out[3 * i + 1], out[3 * i + 2]};
+        cs_springs_damping_row(&sim->springs, r, v, acc);
+        if (sim->wind_normal)
+            wind_row(sim, i, v, acc);
+        memcpy(out + 3 * i, acc, sizeof acc);
     }
 }
 
 /* Owned entries of out; v must be current on the ghosts too. */
 void cs_system_apply(const cs_sim *sim, const double *v, double *out)
 {
-    CS_FOR_LOCAL(sim->par, i)
-        out[3 * i] = out[3 * i + 1] = out[3 * i + 2] = 0;
-    cs_damping_apply(sim, v, out);
-    CS_FOR_OWNED(sim->par, i)
-        for (int d = 0; d < 3; d++)
-            out[3 * i + d] = sim->mass[i] * v[3 * i + d] - sim->h * out[3 * i + d];
+    const int *own = cs_par_owned(sim->par);
+#pragma omp parallel for schedule(static)
+    for (int r = 0; r < sim->par->nowned; r++)
+        system_row(sim, r, own[r], v, out + 3 * own[r]);
 }
 
-static void project(const cs_sim *sim, double *a)
+/* Sums block partials in block order and over ranks (with the maximum of
+ * the block maxima when max is given). */
+static double reduce(cs_sim *sim, const double *sum, const double *max, double *max_out)
 {
-    CS_FOR_OWNED(sim->par, i) {
-        double *ai = a + 3 * i;
-        if (sim->mode[i] == CS_FIXED) {
-            ai[0] = ai[1] = ai[2] = 0;
-        } else if (sim->mode[i] == CS_CONTACT) {
-            const double *N = sim->contact_normal + 3 * i;
-            cs_axpy(-cs_dot(ai, N), N, ai);
-        }
+    int nb = block_count(sim->par);
+    double s = 0, m = 0;
+    for (int b = 0; b < nb; b++) {
+        s += sum[b];
+        if (max && max[b] > m)
+            m = max[b];
     }
-}
-
-/* The owned part of an inner product (summed over ranks by the caller). */
-static double dot_owned(const cs_sim *sim, const double *a, const double *b)
-{
-    double s = 0;
-    CS_FOR_OWNED(sim->par, i)
-        for (int d = 0; d < 3; d++)
-            s += a[3 * i + d] * b[3 * i + d];
+    if (max) {
+        cs_par_sum_max(sim->par, &s, &m);
+        *max_out = m;
+    } else {
+        cs_par_sum(sim->par, &s, 1);
+    }
     return s;
 }
 
-/* r . y and the residual in velocity units, max over particles of
- * |r_i| / m_i, over all ranks in one reduction (a maximum is exact, so
- * every rank count stops at the same iteration). */
-static double dot_and_residual(const cs_sim *sim, const double *r, const double *y,
-                               double *residual)
-{
-    double rho = dot_owned(sim, r, y), worst = 0;
-    CS_FOR_OWNED(sim->par, i) {
-        double s = cs_norm(r + 3 * i) / sim->mass[i];
-        if (s > worst)
-            worst = s;
-    }
-    cs_par_sum_max(sim->par, &rho, &worst);
-    *residual = worst;
-    return rho;
-}
+/* The loops walk blocks of the owned list: rows [r0, r1) of block b. */
+#define FOR_BLOCKS(sim, b, r0, r1)                                                   \
+    _Pragma("omp parallel for schedule(static)")                                     \
+    for (int b = 0; b < block_count((sim)->par); b++)                                \
+        for (int r0 = b * CS_BLOCK, r1 = r0 + CS_BLOCK < (sim)->par->nowned          \
+                                             ? r0 + CS_BLOCK : (sim)->par->nowned;   \
+             r0 < r1; r0 = r1)
 
 /* v0 is read on the ghosts (after a refresh here); v is written where
- * owned. */
+ * owned. The stopping test is the residual in velocity units, max over
+ * particles of |r_i| / m_i: a maximum is exact, so every rank and thread
+ * count stops at the same iteration. */
 int cs_cg_solve(cs_sim *sim, double *v0, const double *rhs, double *v)
 {
     cs_par *par = sim->par;
     cs_cg_work *w = &sim->cg;
+    const int *own = cs_par_owned(par);
+    const cs_springs *s = &sim->springs;
+    double *part_sum = w->partial, *part_max = w->partial + block_count(par);
 
     /* Jacobi preconditioner: diagonal of M - h D */
-    CS_FOR_LOCAL(par, i)
-        w->diag[3 * i] = w->diag[3 * i + 1] = w->diag[3 * i + 2] = 0;
-    cs_springs_add_damping_diagonal(&sim->springs, w->diag);
-    CS_FOR_OWNED(par, i)
+#pragma omp parallel for schedule(static)
+    for (int r = 0; r < par->nowned; r++) {
+        int i = own[r];
+        double acc[3] = {0, 0, 0};
+        for (int e = s->row_start[r]; e < s->row_start[r + 1]; e++) {
+            int k = s->row_spring[e];
+            const double *u = s->direction + 3 * k;
+            for (int d = 0; d < 3; d++)
+                acc[d] += s->damping[k] * u[d] * u[d];
+        }
         for (int d = 0; d < 3; d++) {
             double wind = 0;
             if (sim->wind_normal) {
                 double nd = sim->wind_normal[3 * i + d];
                 wind = sim->def.wind.drag * sim->wind_area[i] * nd * nd;
             }
-            w->diag[3 * i + d] = sim->mass[i] + sim->h * (w->diag[3 * i + d] + wind);
+            w->diag[3 * i + d] = sim->mass[i] + sim->h * (acc[d] + wind);
         }
+    }
 
     /* Start from the explicit update z = P M^-1 r0, exact when the damping
      * does no work (rigid motion). Starting from z = 0 would let a loose
      * tolerance (Table 1's 1e-3 m/s) swallow a step's whole acceleration
      * when dt is small: the solve must resolve only the damping response. */
     cs_halo_forward(par, &par->ghosts, v0, 3);
-    cs_system_apply(sim, v0, w->q);
-    CS_FOR_OWNED(par, i)
+#pragma omp parallel for schedule(static)
+    for (int r = 0; r < par->nowned; r++) {
+        int i = own[r];
+        double q[3], ri[3];
+        system_row(sim, r, i, v0, q);
+        for (int d = 0; d < 3; d++)
+            ri[d] = rhs[3 * i + d] - q[d];
+        project_row(sim, i, ri);
         for (int d = 0; d < 3; d++) {
-            int k = 3 * i + d;
-            w->r[k] = rhs[k] - w->q[k];
+            w->z[3 * i + d] = ri[d] / sim->mass[i];
+            w->y[3 * i + d] = v0[3 * i + d] + w->z[3 * i + d];
         }
-    project(sim, w->r);
-    CS_FOR_OWNED(par, i)
-        for (int d = 0; d < 3; d++) {
-            int k = 3 * i + d;
-            w->z[k] = w->r[k] / sim->mass[i];
-            w->y[k] = v0[k] + w->z[k];
-        }
+    }
     cs_halo_forward(par, &par->ghosts, w->y, 3);
-    cs_system_apply(sim, w->y, w->q);
-    CS_FOR_OWNED(par, i)
-        for (int d = 0; d < 3; d++) {
-            int k = 3 * i + d;
-            w->r[k] = rhs[k] - w->q[k];
+    /* r = P (rhs - A y), p = P diag^-1 r (y is read across particles here,
+     * so the preconditioned residual goes straight into p) */
+    FOR_BLOCKS(sim, b, r0, r1) {
+        double sum = 0, worst = 0;
+        for (int r = r0; r < r1; r++) {
+            int i = own[r];
+            double q[3], *ri = w->r + 3 * i, *pi = w->p + 3 * i;
+            system_row(sim, r, i, w->y, q);
+            for (int d = 0; d < 3; d++)
+                ri[d] = rhs[3 * i + d] - q[d];
+            project_row(sim, i, ri);
+            for (int d = 0; d < 3; d++)
+                pi[d] = ri[d] / w->diag[3 * i + d];
+            project_row(sim, i, pi);
+            for (int d = 0; d < 3; d++)
+                sum += ri[d] * pi[d];
+            worst = fmax(worst, cs_norm(ri) / sim->mass[i]);
         }
-    project(sim, w->r);
-    CS_FOR_OWNED(par, i)
-        for (int d = 0; d < 3; d++) {
-            int k = 3 * i + d;
-            w->y[k] = w->r[k] / w->diag[k];
-        }
-    project(sim, w->y);
-    CS_FOR_OWNED(par, i)
-        memcpy(w->p + 3 * i, w->y + 3 * i, 3 * sizeof(double));
-    double residual, rho = dot_and_residual(sim, w->r, w->y, &residual);
+        part_sum[b] = sum;
+        part_max[b] = worst;
+    }
+    double residual = 0, rho = reduce(sim, part_sum, part_max, &residual);
 
     int it = 0;
     while (it < sim->def.cg_max_iterations && residual > sim->def.cg_tolerance) {
         cs_halo_forward(par, &par->ghosts, w->p, 3);
-        cs_system_apply(sim, w->p, w->q);
-        project(sim, w->q);
-        double pq = dot_owned(sim, w->p, w->q);
-        cs_par_sum(par, &pq, 1);
+        FOR_BLOCKS(sim, b, r0, r1) { /* q = P A p, p . q */
+            double sum = 0;
+            for (int r = r0; r < r1; r++) {
+                int i = own[r];
+                double *qi = w->q + 3 * i;
+                system_row(sim, r, i, w->p, qi);
+                project_row(sim, i, qi);
+                for (int d = 0; d < 3; d++)
+                    sum += w->p[3 * i + d] * qi[d];
+            }
+            part_sum[b] = sum;
+        }
+        double pq = reduce(sim, part_sum, NULL, NULL);
         if (!(pq > 0))
             break; /* not positive definite along p: nothing more to gain */
         double alpha = rho / pq;
-        CS_FOR_OWNED(par, i)
-            for (int d = 0; d < 3; d++) {
-                int k = 3 * i + d;
-                w->z[k] += alpha * w->p[k];
-                w->r[k] -= alpha * w->q[k];
-                w->y[k] = w->r[k] / w->diag[k];
+        FOR_BLOCKS(sim, b, r0, r1) {
+            double sum = 0, worst = 0;
+            for (int r = r0; r < r1; r++) {
+                int i = own[r];
+                double *yi = w->y + 3 * i, *ri = w->r + 3 * i;
+                for (int d = 0; d < 3; d++) {
+                    int k = 3 * i + d;
+                    w->z[k] += alpha * w->p[k];
+                    w->r[k] -= alpha * w->q[k];
+                    yi[d] = w->r[k] / w->diag[k];
+                }
+                project_row(sim, i, yi);
+                for (int d = 0; d < 3; d++)
+                    sum += ri[d] * yi[d];
+                worst = fmax(worst, cs_norm(ri) / sim->mass[i]);
             }
-        project(sim, w->y);
-        double rho_next = dot_and_residual(sim, w->r, w->y, &residual);
+            part_sum[b] = sum;
+            part_max[b] = worst;
+        }
+        double rho_next = reduce(sim, part_sum, part_max, &residual);
         double beta = rho_next / rho;
         rho = rho_next;
-        CS_FOR_OWNED(par, i)
+#pragma omp parallel for schedule(static)
+        for (int r = 0; r < par->nowned; r++)
             for (int d = 0; d < 3; d++) {
-                int k = 3 * i + d;
+                int k = 3 * own[r] + d;
                 w->p[k] = w->y[k] + beta * w->p[k];
             }
         it++;
     }
-    CS_FOR_OWNED(par, i)
-        for (int d = 0; d < 3; d++)
-            v[3 * i + d] = v0[3 * i + d] + w->z[3 * i + d];
+#pragma omp parallel for schedule(static)
+    for (int r = 0; r < par->nowned; r++)
+        for (int d = 0; d < 3; d++) {
+            int k = 3 * own[r] + d;
+            v[k] = v0[k] + w->z[k];
+        }
     return it;
 }

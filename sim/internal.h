@@ -25,8 +25,13 @@ typedef struct cs_cloth_state {
     cs_trimesh *mesh;
 } cs_cloth_state;
 
+/* Threads share owned particles in blocks of this many; sums over them
+ * are taken block by block in block order (the same at any thread count). */
+enum { CS_BLOCK = 1024 };
+
 typedef struct cs_cg_work {
     double *z, *r, *y, *p, *q, *diag, *b;
+    double *partial;  /* 2 per block: a partial sum and a partial maximum */
 } cs_cg_work;
 
 struct cs_sim {
@@ -44,7 +49,8 @@ struct cs_sim {
     double *script_x, *script_v;  /* 3 per particle: targets at t^{n+1} */
     int nbodies;
     cs_body_def *bodies;          /* motion keys owned by the sim */
-    cs_springs springs;
+    cs_springs springs;           /* those this rank computes */
+    int nsprings;                 /* edge and bending springs of the whole scene */
 
     /* step scratch */
     double *x_prev, *v_half, *v_star, *v_next, *force, *v0, *rhs;
@@ -59,7 +65,9 @@ struct cs_sim {
     double *wind_normal;          /* 3 per particle, area weighted unit normal */
     double *wind_area;            /* 1 per particle */
 
-    double t, dt, stable_dt, h;   /* h: half step of the current solve */
+    double t, dt, h;              /* h: half step of the current solve */
+    double stable_dt;             /* 2 / omega_max, omega_max^2 by Lanczos */
+    double gershgorin_dt;         /* the same from Gershgorin's bound (smaller) */
     cs_par *par;                  /* ownership, ghosts, messages (Section 7) */
     unsigned char *active;        /* free and owned here: bodies act on these */
     cs_stage_timing timing[CS_STAGE_COUNT];

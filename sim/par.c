@@ -9,6 +9,8 @@
 #include <string.h>
 #include <time.h>
 
+#include <omp.h>
+
 static double now(void)
 {
     struct timespec ts;
@@ -572,6 +574,35 @@ void cs_parallel_finalize(void)
     if (initialised && !finalised)
         MPI_Finalize();
 }
+
+int cs_parallel_set_threads(int n)
+{
+    if (n <= 0) {
+        const char *env = getenv("OMP_NUM_THREADS");
+        if (env && *env)
+            return omp_get_max_threads(); /* the user's choice, read by libgomp */
+        int local = 1, initialised = 0, finalised = 0;
+        MPI_Initialized(&initialised);
+        MPI_Finalized(&finalised);
+        if (initialised && !finalised) { /* ranks sharing this machine */
+            MPI_Comm node;
+            if (MPI_Comm_split_type(MPI_COMM_WORLD, MPI_COMM_TYPE_SHARED, 0, MPI_INFO_NULL,
+                                    &node) == MPI_SUCCESS) {
+                MPI_Comm_size(node, &local);
+                MPI_Comm_free(&node);
+            }
+        }
+        /* omp_get_num_procs counts the cores of the affinity mask (a rank
+         * mpirun bound to one core sees one); unbound ranks share them */
+        n = omp_get_num_procs() / local;
+        if (n < 1)
+            n = 1;
+    }
+    omp_set_num_threads(n);
+    return n;
+}
+
+int cs_parallel_threads(void) { return omp_get_max_threads(); }
 
 int cs_parallel_rank(void)
 {

@@ -74,6 +74,8 @@ void cs_par_destroy(cs_par *p);
 void cs_par_median_split(int n, const double *x, int parts, int *owner);
 
 static inline bool cs_par_owns(const cs_par *p, int i) { return p->owner[i] == p->rank; }
+/* This rank's particles, ascending (nowned of them). */
+static inline const int *cs_par_owned(const cs_par *p) { return p->order + p->displs[p->rank]; }
 
 /* Owners send their values (width doubles per particle) to the ranks that
  * list them: a ghost refresh. */

@@ -327,6 +327,13 @@ bool cs_parallel_init(int *argc, char ***argv);
 void cs_parallel_finalize(void);
 /* This process's rank in MPI_COMM_WORLD; 0 without MPI. */
 int cs_parallel_rank(void);
+/* OpenMP threads per rank for what follows (call after cs_parallel_init):
+ * n > 0 asks for n; 0 takes OMP_NUM_THREADS when set, else one thread per
+ * core this process may use (its CPU affinity) shared among the ranks
+ * started on this machine, at least one. Returns the count now in force. */
+int cs_parallel_set_threads(int n);
+/* The OpenMP threads each rank uses. */
+int cs_parallel_threads(void);
 
 /* Advances by exactly one time step of the integrator (for tests). */
 int cs_sim_step(cs_sim *sim, double dt);
@@ -337,8 +344,10 @@ long cs_sim_count_intersections(const cs_sim *sim);
 
 double cs_sim_time(const cs_sim *sim);
 double cs_sim_dt(const cs_sim *sim);          /* step used by advance_frame */
-double cs_sim_stable_dt(const cs_sim *sim);   /* stability estimate */
+double cs_sim_stable_dt(const cs_sim *sim);   /* stability limit, 2 / omega_max (Lanczos) */
+double cs_sim_gershgorin_dt(const cs_sim *sim); /* the same from Gershgorin's bound */
 int cs_sim_particle_count(const cs_sim *sim);
+int cs_sim_spring_count(const cs_sim *sim); /* edge and bending springs */
 const double *cs_sim_positions(const cs_sim *sim);
 const double *cs_sim_velocities(const cs_sim *sim);
 const double *cs_sim_masses(const cs_sim *sim);

@@ -1,4 +1,5 @@
 /* springs.c: edge and bending springs, their forces and damping operator. */
+#include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -122,6 +123,51 @@ int cs_springs_add_mesh(cs_springs *s, int offset, int nv, int nt, const int *tr
     return 0;
 }
 
+int cs_springs_index(cs_springs *s, int nrows, const int *particles, int nparticles)
+{
+    free(s->row_start);
+    free(s->row_spring);
+    free(s->row_other);
+    s->nrows = nrows;
+    s->row_particle = particles;
+    s->row_start = calloc((size_t)nrows + 1, sizeof *s->row_start);
+    s->row_spring = malloc(sizeof *s->row_spring * (2 * (size_t)s->n + 1));
+    s->row_other = malloc(sizeof *s->row_other * (2 * (size_t)s->n + 1));
+    int *row_of = malloc(sizeof *row_of * ((size_t)nparticles + 1));
+    if (!s->row_start || !s->row_spring || !s->row_other || !row_of) {
+        free(row_of);
+        return -1;
+    }
+    for (int i = 0; i < nparticles; i++)
+        row_of[i] = -1;
+    for (int r = 0; r < nrows; r++)
+        row_of[particles[r]] = r;
+    for (int k = 0; k < 2 * s->n; k++) {
+        int r = row_of[s->ends[k]];
+        if (r >= 0)
+            s->row_start[r + 1]++;
+    }
+    for (int r = 0; r < nrows; r++)
+        s->row_start[r + 1] += s->row_start[r];
+    int *fill = malloc(sizeof *fill * ((size_t)nrows + 1));
+    if (!fill) {
+        free(row_of);
+        return -1;
+    }
+    memcpy(fill, s->row_start, sizeof *fill * (size_t)nrows);
+    for (int k = 0; k < s->n; k++) /* ascending k: each row in spring order */
+        for (int e = 0; e < 2; e++) {
+            int r = row_of[s->ends[2 * k + e]];
+            if (r < 0)
+                continue;
+            s->row_spring[fill[r]] = k;
+            s->row_other[fill[r]++] = s->ends[2 * k + 1 - e];
+        }
+    free(fill);
+    free(row_of);
+    return 0;
+}
+
 void cs_springs_free(cs_springs *s)
 {
     free(s->ends);
@@ -129,26 +175,40 @@ void cs_springs_free(cs_springs *s)
     free(s->stiffness);
     free(s->damping);
     free(s->direction);
+    free(s->row_start);
+    free(s->row_spring);
+    free(s->row_other);
     memset(s, 0, sizeof *s);
 }
 
+/* Seen from either end, a spring's terms are the same expression in
+ * (self, other): u = x_other - x_self pulls self towards other when
+ * stretched, and (v_other - v_self) . u_hat damps their approach. The
+ * negations this swaps in are exact, so gathering reproduces the
+ * scatter's numbers bit for bit. */
 void cs_springs_add_elastic(const cs_springs *s, const double *x, double *f)
 {
-    for (int k = 0; k < s->n; k++) {
-        int i = s->ends[2 * k], j = s->ends[2 * k + 1];
-        double u[3];
-        cs_sub(x + 3 * j, x + 3 * i, u);
-        double l = cs_norm(u);
-        if (!(l > 0))
-            continue; /* coincident: no direction to push along */
-        double mag = s->stiffness[k] * (l / s->rest_length[k] - 1.0) / l;
-        cs_axpy(mag, u, f + 3 * i);
-        cs_axpy(-mag, u, f + 3 * j);
+#pragma omp parallel for schedule(static)
+    for (int r = 0; r < s->nrows; r++) {
+        int i = s->row_particle[r];
+        double acc[3] = {f[3 * i], f[3 * i + 1], f[3 * i + 2]};
+        for (int e = s->row_start[r]; e < s->row_start[r + 1]; e++) {
+            int k = s->row_spring[e];
+            double u[3];
+            cs_sub(x + 3 * s->row_other[e], x + 3 * i, u);
+            double l = cs_norm(u);
+            if (!(l > 0))
+                continue; /* coincident: no direction to push along */
+            double mag = s->stiffness[k] * (l / s->rest_length[k] - 1.0) / l;
+            cs_axpy(mag, u, acc);
+        }
+        memcpy(f + 3 * i, acc, sizeof acc);
     }
 }
 
 void cs_springs_prepare(cs_springs *s, const double *x)
 {
+#pragma omp parallel for schedule(static)
     for (int k = 0; k < s->n; k++) {
         int i = s->ends[2 * k], j = s->ends[2 * k + 1];
         double *u = s->direction + 3 * k;
@@ -165,26 +225,25 @@ void cs_springs_prepare(cs_springs *s, const double *x)
 
 void cs_springs_add_damping(const cs_springs *s, const double *v, double *out)
 {
-    for (int k = 0; k < s->n; k++) {
-        int i = s->ends[2 * k], j = s->ends[2 * k + 1];
-        const double *u = s->direction + 3 * k;
-        double rel[3];
-        cs_sub(v + 3 * j, v + 3 * i, rel);
-        double mag = s->damping[k] * cs_dot(rel, u);
-        cs_axpy(mag, u, out + 3 * i);
-        cs_axpy(-mag, u, out + 3 * j);
+#pragma omp parallel for schedule(static)
+    for (int r = 0; r < s->nrows; r++) {
+        int i = s->row_particle[r];
+        double acc[3] = {out[3 * i], out[3 * i + 1], out[3 * i + 2]};
+        cs_springs_damping_row(s, r, v, acc);
+        memcpy(out + 3 * i, acc, sizeof acc);
     }
 }
 
 void cs_springs_add_damping_diagonal(const cs_springs *s, double *diag)
 {
-    for (int k = 0; k < s->n; k++) {
-        int i = s->ends[2 * k], j = s->ends[2 * k + 1];
-        const double *u = s->direction + 3 * k;
-        for (int d = 0; d < 3; d++) {
-            double a = s->damping[k] * u[d] * u[d];
-            diag[3 * i + d] += a;
-            diag[3 * j + d] += a;
+#pragma omp parallel for schedule(static)
+    for (int r = 0; r < s->nrows; r++) {
+        int i = s->row_particle[r];
+        for (int e = s->row_start[r]; e < s->row_start[r + 1]; e++) {
+            int k = s->row_spring[e];
+            const double *u = s->direction + 3 * k;
+            for (int d = 0; d < 3; d++)
+                diag[3 * i + d] += s->damping[k] * u[d] * u[d];
         }
     }
 }
@@ -225,4 +284,126 @@ void cs_springs_keep_touching(cs_springs *s, const int *owner, int rank)
     }
     s->n = kept;
     s->nedge = kept_edge;
+}
+
+/* out = K v over free particles: the rest-state stiffness of every spring,
+ * (E / L0) u u^T with u along the spring at positions x (fixed particles
+ * are constraints: their entries stay zero). */
+static void stiffness_apply(const cs_springs *s, const double *x, const unsigned char *is_free,
+                            int n, const double *v, double *out)
+{
+    memset(out, 0, sizeof *out * 3 * (size_t)n);
+    for (int k = 0; k < s->n; k++) {
+        int i = s->ends[2 * k], j = s->ends[2 * k + 1];
+        double u[3];
+        cs_sub(x + 3 * j, x + 3 * i, u);
+        double l = cs_norm(u);
+        if (!(l > 0))
+            continue;
+        double vi[3] = {0, 0, 0}, vj[3] = {0, 0, 0};
+        if (is_free[i])
+            memcpy(vi, v + 3 * i, sizeof vi);
+        if (is_free[j])
+            memcpy(vj, v + 3 * j, sizeof vj);
+        double rel[3];
+        cs_sub(vj, vi, rel);
+        double mag = s->stiffness[k] / s->rest_length[k] * cs_dot(rel, u) / (l * l);
+        if (is_free[i])
+            cs_axpy(-mag, u, out + 3 * i);
+        if (is_free[j])
+            cs_axpy(mag, u, out + 3 * j);
+    }
+}
+
+/* Largest eigenvalue of a symmetric tridiagonal matrix (diagonal a, off
+ * diagonal b) by bisection on the Sturm count: exact to round-off. */
+static double tridiagonal_max_eigenvalue(const double *a, const double *b, int m)
+{
+    double lo = INFINITY, hi = -INFINITY;
+    for (int i = 0; i < m; i++) { /* Gershgorin interval */
+        double r = (i > 0 ? fabs(b[i - 1]) : 0) + (i + 1 < m ? fabs(b[i]) : 0);
+        lo = fmin(lo, a[i] - r);
+        hi = fmax(hi, a[i] + r);
+    }
+    for (int it = 0; it < 200 && hi - lo > 1e-15 * fabs(hi); it++) {
+        double mid = 0.5 * (lo + hi), d = 1;
+        int above = 0; /* eigenvalues greater than mid */
+        for (int i = 0; i < m; i++) {
+            d = a[i] - mid - (i > 0 ? b[i - 1] * b[i - 1] / d : 0);
+            if (d == 0)
+                d = -1e-300;
+            above += d > 0;
+        }
+        if (above > 0)
+            lo = mid;
+        else
+            hi = mid;
+    }
+    return hi;
+}
+
+double cs_springs_max_eigenvalue(const cs_springs *s, const double *x, const double *mass,
+                                 const unsigned char *is_free, int n, int steps)
+{
+    /* Lanczos on the symmetric A = M^-1/2 K M^-1/2, which has the
+     * eigenvalues of M^-1 K; its largest Ritz value converges to the top of
+     * the spectrum in a few dozen steps, from below. */
+    size_t len = 3 * (size_t)n;
+    double *q = calloc(len + 1, sizeof *q), *q_prev = calloc(len + 1, sizeof *q_prev);
+    double *w = calloc(len + 1, sizeof *w), *t = calloc(len + 1, sizeof *t);
+    double *alpha = calloc((size_t)steps + 1, sizeof *alpha);
+    double *beta = calloc((size_t)steps + 1, sizeof *beta);
+    double result = -1;
+    if (!q || !q_prev || !w || !t || !alpha || !beta)
+        goto done;
+    unsigned long long seed = 88172645463325252ull; /* xorshift: the same start everywhere */
+    double norm = 0;
+    for (size_t k = 0; k < len; k++) {
+        seed ^= seed << 13;
+        seed ^= seed >> 7;
+        seed ^= seed << 17;
+        q[k] = is_free[k / 3] ? (double)(seed >> 11) / 9007199254740992.0 - 0.5 : 0;
+        norm += q[k] * q[k];
+    }
+    if (!(norm > 0)) {
+        result = 0; /* nothing free: nothing oscillates */
+        goto done;
+    }
+    for (size_t k = 0; k < len; k++)
+        q[k] /= sqrt(norm);
+    int m = 0;
+    for (; m < steps; m++) {
+        for (size_t k = 0; k < len; k++) /* A q = M^-1/2 K M^-1/2 q */
+            t[k] = q[k] / sqrt(mass[k / 3]);
+        stiffness_apply(s, x, is_free, n, t, w);
+        double a = 0;
+        for (size_t k = 0; k < len; k++) {
+            w[k] /= sqrt(mass[k / 3]);
+            a += w[k] * q[k];
+        }
+        alpha[m] = a;
+        double bnorm = 0;
+        for (size_t k = 0; k < len; k++) {
+            w[k] -= a * q[k] + (m > 0 ? beta[m - 1] * q_prev[k] : 0);
+            bnorm += w[k] * w[k];
+        }
+        beta[m] = sqrt(bnorm);
+        if (!(beta[m] > 1e-12 * fabs(a))) { /* an invariant subspace: exact */
+            m++;
+            break;
+        }
+        for (size_t k = 0; k < len; k++) {
+            q_prev[k] = q[k];
+            q[k] = w[k] / beta[m];
+        }
+    }
+    result = tridiagonal_max_eigenvalue(alpha, beta, m);
+done:
+    free(q);
+    free(q_prev);
+    free(w);
+    free(t);
+    free(alpha);
+    free(beta);
+    return result;
 }

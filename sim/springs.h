@@ -21,6 +21,15 @@ typedef struct cs_springs {
     double *direction;   /* 3 per spring: u_hat at the last cs_springs_prepare */
     int nedge;           /* the first nedge springs are edge springs */
     int skipped;         /* degenerate (zero rest length) springs left out */
+    /* Each updated particle's springs (cs_springs_index), in spring order:
+     * row r is particle row_particle[r], its springs row_spring[row_start[r]
+     * .. row_start[r + 1]) with far ends row_other[...]. The kernels gather
+     * per particle instead of scattering per spring, so threads never write
+     * the same particle and every particle sums its springs in the same
+     * order at any thread count (the order the scatter loop had). */
+    int nrows;
+    const int *row_particle;
+    int *row_start, *row_spring, *row_other;
 } cs_springs;
 
 /* Appends the edge and bending springs of a triangle mesh whose vertices are
@@ -33,6 +42,29 @@ int cs_springs_add_mesh(cs_springs *s, int offset, int nv, int nt, const int *tr
                         double edge_E, double edge_xi, double bend_E, double bend_xi);
 void cs_springs_free(cs_springs *s);
 
+/* Row r's damping force (D v) added into acc: the kernel of
+ * cs_springs_add_damping, inlined where a caller fuses it with more work. */
+static inline void cs_springs_damping_row(const cs_springs *s, int r, const double *v,
+                                          double acc[3])
+{
+    const double *vi = v + 3 * s->row_particle[r];
+    for (int e = s->row_start[r]; e < s->row_start[r + 1]; e++) {
+        int k = s->row_spring[e];
+        const double *u = s->direction + 3 * k, *vo = v + 3 * s->row_other[e];
+        double rel[3] = {vo[0] - vi[0], vo[1] - vi[1], vo[2] - vi[2]};
+        double mag = s->damping[k] * (rel[0] * u[0] + rel[1] * u[1] + rel[2] * u[2]);
+        acc[0] += mag * u[0];
+        acc[1] += mag * u[1];
+        acc[2] += mag * u[2];
+    }
+}
+
+/* Builds the per-particle rows for the nrows particles listed (kept, not
+ * copied); call again after the springs change. Returns 0 or -1. */
+int cs_springs_index(cs_springs *s, int nrows, const int *particles, int nparticles);
+
+/* The kernels below write the rows' particles only (OpenMP threads share
+ * them). */
 /* Elastic forces only (the explicit part), added into f. */
 void cs_springs_add_elastic(const cs_springs *s, const double *x, double *f);
 /* Stores u_hat of every spring at positions x for the damping operator. */
@@ -49,5 +81,11 @@ void cs_springs_keep_touching(cs_springs *s, const int *owner, int rank);
  * with is_free[i] set: per particle 2 * sum(E/L0) / m. */
 double cs_springs_stiffness_bound(const cs_springs *s, const double *mass,
                                   const unsigned char *is_free, int nparticles);
+/* The largest eigenvalue of M^-1 K for the rest-state stiffness K at
+ * positions x, over particles with is_free set, by `steps` Lanczos
+ * iterations (a lower estimate that converges quickly; the Gershgorin bound
+ * above is an upper one). Returns -1 when memory runs out. */
+double cs_springs_max_eigenvalue(const cs_springs *s, const double *x, const double *mass,
+                                 const unsigned char *is_free, int n, int steps);
 
 #endif
