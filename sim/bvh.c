@@ -124,29 +124,67 @@ typedef struct traversal {
     const cs_box *box_a, *box_b;
     bool self, only_dirty;
     int rank;
-    cs_bvh_pair_fn fn;
-    void *ctx;
+    int depth;            /* planning: node pairs this deep become tasks */
+    cs_bvh_work *plan;    /* planning: where the tasks go; NULL when traversing */
+    cs_index_pairs *out;  /* traversing: where the pairs go */
+    int failed;
 } traversal;
 
-static void leaf_pairs(const traversal *tr, int i, int j)
+static bool push_pair(cs_index_pairs *l, int a, int b)
+{
+    if (l->n == l->capacity) {
+        int cap = l->capacity ? 2 * l->capacity : 1024;
+        int *ab = realloc(l->ab, sizeof *ab * 2 * (size_t)cap);
+        if (!ab)
+            return false;
+        l->ab = ab;
+        l->capacity = cap;
+    }
+    l->ab[2 * l->n] = a;
+    l->ab[2 * l->n++ + 1] = b;
+    return true;
+}
+
+static void leaf_pairs(traversal *tr, int i, int j)
 {
     const cs_bvh *A = tr->A, *B = tr->B;
     for (int ka = A->first[i]; ka < A->first[i] + A->count[i]; ka++) {
         int a = A->order[ka];
+        const cs_box *ba = tr->box_a + a;
         int kb0 = (tr->self && i == j) ? ka + 1 : B->first[j];
         for (int kb = kb0; kb < B->first[j] + B->count[j]; kb++) {
             int b = B->order[kb];
-            if (!cs_box_overlap(tr->box_a + a, tr->box_b + b))
+            if (!cs_box_overlap(ba, tr->box_b + b))
                 continue;
-            if (tr->self && a > b)
-                tr->fn(tr->ctx, b, a);
-            else
-                tr->fn(tr->ctx, a, b);
+            bool ok = tr->self && a > b ? push_pair(tr->out, b, a) : push_pair(tr->out, a, b);
+            tr->failed |= !ok;
         }
     }
 }
 
-static void descend(const traversal *tr, int i, int j)
+/* Planning stops here, deep enough or at leaves: the node pair is a task
+ * for later. */
+static bool planned(traversal *tr, int i, int j, int depth, bool leaves)
+{
+    if (!tr->plan || (depth < tr->depth && !leaves))
+        return false;
+    cs_bvh_work *w = tr->plan;
+    if (w->ntasks == w->task_capacity) {
+        int cap = w->task_capacity ? 2 * w->task_capacity : 256;
+        int *t = realloc(w->task, sizeof *t * 2 * (size_t)cap);
+        if (!t) {
+            tr->failed = 1;
+            return true;
+        }
+        w->task = t;
+        w->task_capacity = cap;
+    }
+    w->task[2 * w->ntasks] = i;
+    w->task[2 * w->ntasks++ + 1] = j;
+    return true;
+}
+
+static void descend(traversal *tr, int i, int j, int depth)
 {
     const cs_bvh *A = tr->A, *B = tr->B;
     if (tr->only_dirty && !A->dirty[i] && !B->dirty[j])
@@ -160,19 +198,23 @@ static void descend(const traversal *tr, int i, int j)
     }
     if (tr->self && i == j) {
         int l = A->child[2 * i];
+        if (planned(tr, i, i, depth, l < 0))
+            return;
         if (l < 0) {
             leaf_pairs(tr, i, i);
             return;
         }
         int r = A->child[2 * i + 1];
-        descend(tr, l, l);
-        descend(tr, r, r);
-        descend(tr, l, r);
+        descend(tr, l, l, depth + 1);
+        descend(tr, r, r, depth + 1);
+        descend(tr, l, r, depth + 1);
         return;
     }
     if (!cs_box_overlap(A->box + i, B->box + j))
         return;
     int la = A->child[2 * i], lb = B->child[2 * j];
+    if (planned(tr, i, j, depth, la < 0 && lb < 0))
+        return;
     if (la < 0 && lb < 0) {
         leaf_pairs(tr, i, j);
         return;
@@ -188,31 +230,72 @@ static void descend(const traversal *tr, int i, int j)
         split_a = va >= vb;
     }
     if (split_a) {
-        descend(tr, la, j);
-        descend(tr, A->child[2 * i + 1], j);
+        descend(tr, la, j, depth + 1);
+        descend(tr, A->child[2 * i + 1], j, depth + 1);
     } else {
-        descend(tr, i, lb);
-        descend(tr, i, B->child[2 * j + 1]);
+        descend(tr, i, lb, depth + 1);
+        descend(tr, i, B->child[2 * j + 1], depth + 1);
     }
 }
 
-void cs_bvh_pairs(const cs_bvh *A, const cs_bvh *B, const cs_box *box_a, const cs_box *box_b,
-                  bool only_dirty, cs_bvh_pair_fn fn, void *ctx)
+/* Node pairs this deep become tasks: up to 4^depth of them, many per thread
+ * so uneven ones even out. */
+enum { TASK_DEPTH = 8 };
+
+int cs_bvh_collect(const cs_bvh *A, const cs_bvh *B, const cs_box *box_a, const cs_box *box_b,
+                   bool only_dirty, int rank, cs_bvh_work *w, cs_index_pairs *out)
 {
+    out->n = 0;
+    w->ntasks = 0;
     if (A->nnodes == 0 || B->nnodes == 0)
-        return;
-    traversal tr = {A, B, box_a, box_b, A == B, only_dirty, -1, fn, ctx};
-    descend(&tr, 0, 0);
+        return 0;
+    traversal plan = {A, B, box_a, box_b, A == B, only_dirty, rank, TASK_DEPTH, w, NULL, 0};
+    descend(&plan, 0, 0, 0);
+    if (plan.failed)
+        return -1;
+    if (w->ntasks > w->found_capacity) {
+        cs_index_pairs *f = realloc(w->found, sizeof *f * (size_t)w->ntasks);
+        if (!f)
+            return -1;
+        memset(f + w->found_capacity, 0, sizeof *f * (size_t)(w->ntasks - w->found_capacity));
+        w->found = f;
+        w->found_capacity = w->ntasks;
+    }
+    int failed = 0;
+#pragma omp parallel for schedule(dynamic, 1) reduction(| : failed)
+    for (int t = 0; t < w->ntasks; t++) {
+        traversal tr = {A, B, box_a, box_b, A == B, only_dirty, rank, 0, NULL, w->found + t, 0};
+        tr.out->n = 0;
+        descend(&tr, w->task[2 * t], w->task[2 * t + 1], 0);
+        failed |= tr.failed;
+    }
+    long total = 0;
+    for (int t = 0; t < w->ntasks; t++)
+        total += w->found[t].n;
+    if (failed || total > INT_MAX / 2)
+        return -1;
+    if (total > out->capacity) {
+        int *ab = realloc(out->ab, sizeof *ab * 2 * (size_t)total);
+        if (!ab)
+            return -1;
+        out->ab = ab;
+        out->capacity = (int)total;
+    }
+    for (int t = 0; t < w->ntasks; t++) { /* task order: the depth-first order */
+        if (w->found[t].n > 0)
+            memcpy(out->ab + 2 * (size_t)out->n, w->found[t].ab, sizeof *out->ab * 2 * (size_t)w->found[t].n);
+        out->n += w->found[t].n;
+    }
+    return 0;
 }
 
-void cs_bvh_pairs_for_rank(const cs_bvh *A, const cs_bvh *B, const cs_box *box_a,
-                           const cs_box *box_b, bool only_dirty, int rank, cs_bvh_pair_fn fn,
-                           void *ctx)
+void cs_bvh_work_free(cs_bvh_work *w)
 {
-    if (A->nnodes == 0 || B->nnodes == 0)
-        return;
-    traversal tr = {A, B, box_a, box_b, A == B, only_dirty, rank, fn, ctx};
-    descend(&tr, 0, 0);
+    for (int t = 0; t < w->found_capacity; t++)
+        free(w->found[t].ab);
+    free(w->found);
+    free(w->task);
+    memset(w, 0, sizeof *w);
 }
 
 int cs_bvh_set_ranks(cs_bvh *t, const int *prim_rank)

@@ -30,21 +30,35 @@ void cs_bvh_free(cs_bvh *t);
 /* Sets node boxes from primitive boxes; prim_dirty may be NULL (all clean). */
 void cs_bvh_refit(cs_bvh *t, const cs_box *prim_box, const unsigned char *prim_dirty);
 
-/* Calls fn(ctx, a, b) for every pair of primitives a of A and b of B whose
- * boxes overlap (for A == B each unordered pair a < b once). With
- * only_dirty, node pairs where neither side is dirty are skipped. */
-typedef void (*cs_bvh_pair_fn)(void *ctx, int a, int b);
-void cs_bvh_pairs(const cs_bvh *A, const cs_bvh *B, const cs_box *box_a, const cs_box *box_b,
-                  bool only_dirty, cs_bvh_pair_fn fn, void *ctx);
-
 /* Section 7: each primitive's rank (the lowest owner of its particles); a
  * pair goes to the lower of its two primitives' ranks. */
 int cs_bvh_set_ranks(cs_bvh *t, const int *prim_rank);
-/* cs_bvh_pairs pruned to the node pairs that can hold a pair going to
- * rank (after cs_bvh_set_ranks on both trees); fn still checks each pair. */
-void cs_bvh_pairs_for_rank(const cs_bvh *A, const cs_bvh *B, const cs_box *box_a,
-                           const cs_box *box_b, bool only_dirty, int rank, cs_bvh_pair_fn fn,
-                           void *ctx);
+
+/* Primitive pairs as (a, b) integer pairs, 2 ints each. */
+typedef struct cs_index_pairs {
+    int n, capacity;
+    int *ab;
+} cs_index_pairs;
+
+/* Scratch a traversal reuses from call to call. */
+typedef struct cs_bvh_work {
+    int ntasks, task_capacity;
+    int *task;                 /* 2 per task: a node of A, a node of B */
+    cs_index_pairs *found;     /* per task */
+    int found_capacity;
+} cs_bvh_work;
+void cs_bvh_work_free(cs_bvh_work *w);
+
+/* Every pair of primitives a of A and b of B whose boxes overlap (for
+ * A == B each unordered pair once, as a < b), into out in the order of a
+ * depth-first traversal whatever the thread count: the node pairs near the
+ * top become tasks that OpenMP threads traverse into their own lists,
+ * joined in task order. With only_dirty, node pairs where neither side is
+ * dirty are skipped; with rank >= 0 (after cs_bvh_set_ranks on both trees),
+ * node pairs that cannot hold a pair going to rank. Returns 0 or -1 (no
+ * memory). */
+int cs_bvh_collect(const cs_bvh *A, const cs_bvh *B, const cs_box *box_a, const cs_box *box_b,
+                   bool only_dirty, int rank, cs_bvh_work *w, cs_index_pairs *out);
 
 static inline bool cs_box_overlap(const cs_box *a, const cs_box *b)
 {

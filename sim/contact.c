@@ -97,7 +97,7 @@ typedef struct late_queue {
                              failed for want of memory) */
 } late_queue;
 
-static void late_push(late_queue *q, int b, int i)
+static void late_push_unlocked(late_queue *q, int b, int i)
 {
     if (q->n == q->cap) {
         int cap = q->cap ? 2 * q->cap : 64;
@@ -117,6 +117,14 @@ static void late_push(late_queue *q, int b, int i)
     q->point[q->n] = i;
     q->next[q->n] = q->head[b];
     q->head[b] = q->n++;
+}
+
+/* Threads visit points side by side: the queue is one list, and the order
+ * of its entries does not matter (a visit changes only its own point). */
+static void late_push(late_queue *q, int b, int i)
+{
+#pragma omp critical(cs_late_queue)
+    late_push_unlocked(q, b, i);
 }
 
 typedef struct collide_ctx {
@@ -186,14 +194,18 @@ void cs_body_collide(cs_sim *sim, double dt)
         for (int i = 0; g.ok && i < n; i++)
             c.seen[i] = -1;
     }
+    const int *own = cs_par_owned(sim->par);
     for (int b = 0; b < nb; b++) {
         if (!g.ok || !g.bounded[b] || b >= c.q.all_from) {
-            CS_FOR_OWNED(sim->par, i)
-                if (sim->active[i])
-                    visit(&c, i, b);
+#pragma omp parallel for schedule(static)
+            for (int r = 0; r < sim->par->nowned; r++)
+                if (sim->active[own[r]])
+                    visit(&c, own[r], b);
             continue;
         }
-        /* the points listed for b, then those queued for it since */
+        /* the points listed for b, then those queued for it since (only
+         * bodies before b queue points for it) */
+#pragma omp parallel for schedule(static)
         for (int k = g.start[b]; k < g.start[b + 1]; k++)
             visit(&c, g.points[k], b);
         for (int e = c.q.head[b]; e >= 0; e = c.q.next[e])

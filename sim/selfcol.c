@@ -26,6 +26,8 @@ static int pair_push(cs_pair_list *l, const int v[4], const double *s0)
     memcpy(q->v, v, sizeof q->v);
     if (s0)
         memcpy(q->s0, s0, sizeof q->s0);
+    else
+        q->s0[0] = q->s0[1] = q->s0[2] = 0;
     return 0;
 }
 
@@ -165,6 +167,10 @@ void cs_selfcol_destroy(cs_selfcol *sc)
     for (size_t k = 0; k < sizeof arrays / sizeof *arrays; k++)
         free(arrays[k]);
     cs_halo_free(&sc->bhalo);
+    cs_bvh_work_free(&sc->bvh_work);
+    free(sc->candidates.ab);
+    free(sc->made);
+    free(sc->keep);
     free(sc);
 }
 
@@ -542,14 +548,13 @@ typedef struct finder {
     cs_sim *sim;
     cs_selfcol *sc;
     double h, span;
-    int failed;
 } finder;
 
 /* Keep a pair only if it can come within h during the span at its present
  * relative velocity: distance in the free state less the largest relative
  * speed between its two sides times the span. (The boxes that found it had
- * to allow for each particle's absolute motion; a patch moving fast but
- * rigidly, like the twisted strip's ends, has little relative motion.) */
+ * to allow for each particle's motion; a patch moving fast but rigidly,
+ * like the twisted strip's ends, has little relative motion.) */
 static bool may_meet(const finder *f, const int v[4], int split, double dist)
 {
     const double *vel = f->sim->v;
@@ -563,19 +568,23 @@ static bool may_meet(const finder *f, const int v[4], int split, double dist)
     return dist < f->h + rel * f->span;
 }
 
-static void found_point_triangle(void *ctx, int point, int t)
+/* The makers below turn a candidate (a, b) of a traversal into a pair, or
+ * say no; they only read shared state, so threads run them side by side. */
+typedef bool (*pair_maker)(const void *ctx, int a, int b, cs_pair *out);
+
+static bool make_repulsion_point_triangle(const void *ctx, int point, int t, cs_pair *out)
 {
-    finder *f = ctx;
-    cs_selfcol *sc = f->sc;
+    const finder *f = ctx;
+    const cs_selfcol *sc = f->sc;
     const int *tri = sc->tri + 3 * t;
     if (point == tri[0] || point == tri[1] || point == tri[2] || wing_pair(sc, point, tri))
-        return;
+        return false;
     int quad[4] = {tri[0], tri[1], tri[2], point};
     if (pair_rank(f->sim->par, quad) != f->sim->par->rank)
-        return; /* another rank's to find */
+        return false; /* another rank's to find */
     if (sc->inv_mass[point] == 0 && sc->inv_mass[tri[0]] == 0 && sc->inv_mass[tri[1]] == 0 &&
         sc->inv_mass[tri[2]] == 0)
-        return;
+        return false;
     /* history: wind the triangle so its normal points at the free point
      * (the paper's reordering; swapping two triangle vertices flips it) */
     const double *x = sc->x_free;
@@ -589,7 +598,7 @@ static void found_point_triangle(void *ctx, int point, int t)
     double dist = cs_point_triangle_closest(x + 3 * point, x + 3 * tri[0], x + 3 * tri[1],
                                             x + 3 * tri[2], w);
     if (!may_meet(f, v, 3, dist))
-        return;
+        return false;
     double side = cs_dot(nrm, r);
     if (fabs(side) <= 1e-12 * cs_norm(nrm) * (cs_norm(r) + cs_norm(e1)))
         side = ring_side(sc, x, point, nrm); /* in the plane: ambiguous */
@@ -597,22 +606,24 @@ static void found_point_triangle(void *ctx, int point, int t)
         v[1] = tri[2];
         v[2] = tri[1];
     }
-    f->failed |= pair_push(&sc->pt, v, NULL);
+    memcpy(out->v, v, sizeof v);
+    out->s0[0] = out->s0[1] = out->s0[2] = 0;
+    return true;
 }
 
-static void found_edge_edge(void *ctx, int ea, int eb)
+static bool make_repulsion_edge_edge(const void *ctx, int ea, int eb, cs_pair *out)
 {
-    finder *f = ctx;
-    cs_selfcol *sc = f->sc;
+    const finder *f = ctx;
+    const cs_selfcol *sc = f->sc;
     const int *a = sc->edge + 2 * ea, *b = sc->edge + 2 * eb;
     if (a[0] == b[0] || a[0] == b[1] || a[1] == b[0] || a[1] == b[1])
-        return;
+        return false;
     int quad[4] = {a[0], a[1], b[0], b[1]};
     if (pair_rank(f->sim->par, quad) != f->sim->par->rank)
-        return; /* another rank's to find */
+        return false; /* another rank's to find */
     if (sc->inv_mass[a[0]] == 0 && sc->inv_mass[a[1]] == 0 && sc->inv_mass[b[0]] == 0 &&
         sc->inv_mass[b[1]] == 0)
-        return;
+        return false;
     const double *x = sc->x_free;
     double s, t, s0[3];
     cs_segment_segment_closest(x + 3 * a[0], x + 3 * a[1], x + 3 * b[0], x + 3 * b[1], &s, &t);
@@ -620,9 +631,8 @@ static void found_edge_edge(void *ctx, int ea, int eb)
         s0[k] = (x[3 * b[0] + k] + t * (x[3 * b[1] + k] - x[3 * b[0] + k])) -
                 (x[3 * a[0] + k] + s * (x[3 * a[1] + k] - x[3 * a[0] + k]));
     double len = cs_norm(s0);
-    int v[4] = {a[0], a[1], b[0], b[1]};
-    if (!may_meet(f, v, 2, len))
-        return;
+    if (!may_meet(f, quad, 2, len))
+        return false;
     if (!(len > 0)) { /* touching in the free state: the edges' common normal */
         double da[3], db[3];
         cs_sub(x + 3 * a[1], x + 3 * a[0], da);
@@ -630,11 +640,43 @@ static void found_edge_edge(void *ctx, int ea, int eb)
         cs_cross(da, db, s0);
         len = cs_norm(s0);
         if (!(len > 0))
-            return; /* parallel and touching: the point/triangle pairs decide */
+            return false; /* parallel and touching: the point/triangle pairs decide */
     }
+    memcpy(out->v, quad, sizeof quad);
     for (int k = 0; k < 3; k++)
-        s0[k] /= len;
-    f->failed |= pair_push(&sc->ee, v, s0);
+        out->s0[k] = s0[k] / len;
+    return true;
+}
+
+/* Traverses A against B and appends the pairs make accepts to list, in the
+ * traversal's order at any thread count: threads make pairs from the
+ * candidates in place, then they are kept in order. Returns 0 or -1. */
+static int find_pairs(cs_selfcol *sc, const cs_bvh *A, const cs_bvh *B, const cs_box *box_a,
+                      const cs_box *box_b, bool only_dirty, int rank, pair_maker make,
+                      const void *ctx, cs_pair_list *list)
+{
+    if (cs_bvh_collect(A, B, box_a, box_b, only_dirty, rank, &sc->bvh_work, &sc->candidates))
+        return -1;
+    int n = sc->candidates.n;
+    if (n > sc->made_capacity) {
+        cs_pair *made = realloc(sc->made, sizeof *made * (size_t)n);
+        unsigned char *keep = realloc(sc->keep, (size_t)n);
+        if (made)
+            sc->made = made;
+        if (keep)
+            sc->keep = keep;
+        if (!made || !keep)
+            return -1;
+        sc->made_capacity = n;
+    }
+    const int *ab = sc->candidates.ab;
+#pragma omp parallel for schedule(dynamic, 256)
+    for (int k = 0; k < n; k++)
+        sc->keep[k] = make(ctx, ab[2 * k], ab[2 * k + 1], sc->made + k);
+    for (int k = 0; k < n; k++)
+        if (sc->keep[k] && pair_push(list, sc->made[k].v, sc->made[k].s0))
+            return -1;
+    return 0;
 }
 
 void cs_selfcol_find_pairs(cs_sim *sim, double span)
@@ -645,11 +687,20 @@ void cs_selfcol_find_pairs(cs_sim *sim, double span)
     double h = sim->def.self.thickness;
     sc->pt.n = sc->ee.n = 0;
     /* non-aggressive pruning: boxes grow by h/2 plus the distance each
-     * particle would cover in the span at its present speed (a pair that
-     * comes closer faster than that is step C's to catch) */
+     * particle would cover in the span at its present velocity relative to
+     * the cloth's mean velocity (a pair's relative speed is at most the sum
+     * of its particles' speeds relative to any common velocity, and only
+     * relative motion brings a pair closer: a sheet falling rigidly needs
+     * no wider boxes than one at rest). A pair that comes closer faster
+     * than that is step C's to catch. */
+    double mean[3] = {0, 0, 0};
+    for (int i = 0; i < sc->n; i++)
+        cs_axpy(1.0 / sc->n, sim->v + 3 * i, mean);
     double *margin = sim->force; /* scratch, free between steps */
     for (int i = 0; i < sc->n; i++) {
-        margin[i] = 0.5 * h + cs_norm(sim->v + 3 * i) * span;
+        double rel[3];
+        cs_sub(sim->v + 3 * i, mean, rel);
+        margin[i] = 0.5 * h + cs_norm(rel) * span;
         cs_box_empty(sc->pbox + i);
         cs_box_add_point(sc->pbox + i, x + 3 * i);
         cs_box_thicken(sc->pbox + i, margin[i]);
@@ -676,16 +727,16 @@ void cs_selfcol_find_pairs(cs_sim *sim, double span)
     cs_bvh_refit(&sc->ptree, sc->pbox, NULL);
     cs_bvh_refit(&sc->etree, sc->ebox, NULL);
     cs_bvh_refit(&sc->ttree, sc->tbox, NULL);
-    finder f = {sim, sc, h, span, 0};
+    finder f = {sim, sc, h, span};
     int rank = sim->par->rank;
-    cs_bvh_pairs_for_rank(&sc->ptree, &sc->ttree, sc->pbox, sc->tbox, false, rank,
-                          found_point_triangle, &f);
-    cs_bvh_pairs_for_rank(&sc->etree, &sc->etree, sc->ebox, sc->ebox, false, rank,
-                          found_edge_edge, &f);
+    int failed = find_pairs(sc, &sc->ptree, &sc->ttree, sc->pbox, sc->tbox, false, rank,
+                            make_repulsion_point_triangle, &f, &sc->pt) ||
+                 find_pairs(sc, &sc->etree, &sc->etree, sc->ebox, sc->ebox, false, rank,
+                            make_repulsion_edge_edge, &f, &sc->ee);
     sc->stats.repulsion_pairs += sc->pt.n + sc->ee.n;
     if (distribute_boundary(sim, &sc->pt, &sc->ee) != 0)
-        f.failed = 1;
-    if (f.failed) /* out of memory: without pairs step C still keeps the cloth apart */
+        failed = 1;
+    if (failed) /* out of memory: without pairs step C still keeps the cloth apart */
         sc->pt.n = sc->ee.n = sc->bpt.n = sc->bee.n = 0;
 }
 
@@ -722,6 +773,53 @@ static void pair_at(const cs_selfcol *sc, const cs_pair *p, const double *x, dou
         }
 }
 
+/* The conservative filter before any root finding. Along linear
+ * trajectories the relative position of the pair at fixed weights moves by
+ * a convex combination of the displacements of one side's vertices
+ * relative to the other's, so the distance between the primitives never
+ * drops faster than the largest such relative displacement ("reach"): a
+ * pair farther apart at the start than the proximity tolerance plus its
+ * reach cannot collide over the span. A sheet moving rigidly (reach 0) is
+ * settled by one distance per pair instead of a vanishing cubic sampled 31
+ * times. The slack covers the round-off of the distances compared. */
+static bool out_of_reach(const cs_selfcol *sc, bool is_edge, const double *x0, const double *dx)
+{
+    int split = is_edge ? 2 : 3; /* one side: vertices [0, split) */
+    double reach2 = 0, scale = 0;
+    for (int i = 0; i < split; i++)
+        for (int j = split; j < 4; j++) {
+            double r[3];
+            cs_sub(dx + 3 * j, dx + 3 * i, r);
+            reach2 = fmax(reach2, cs_dot(r, r));
+        }
+    for (int k = 0; k < 12; k++)
+        scale = fmax(scale, fabs(x0[k]) + fabs(dx[k]));
+    double need = sc->proximity + sqrt(reach2);
+    need += 64 * DBL_EPSILON * (scale + need);
+    /* a separating axis of the start boxes bounds the distance first */
+    for (int d = 0; d < 3; d++) {
+        double lo_a = INFINITY, hi_a = -INFINITY, lo_b = INFINITY, hi_b = -INFINITY;
+        for (int k = 0; k < 4; k++) {
+            double c = x0[3 * k + d];
+            if (k < split) {
+                lo_a = fmin(lo_a, c);
+                hi_a = fmax(hi_a, c);
+            } else {
+                lo_b = fmin(lo_b, c);
+                hi_b = fmax(hi_b, c);
+            }
+        }
+        if (lo_a - hi_b > need || lo_b - hi_a > need)
+            return true;
+    }
+    double d0, w[3], s, t;
+    if (is_edge)
+        d0 = cs_segment_segment_closest(x0, x0 + 3, x0 + 6, x0 + 9, &s, &t);
+    else
+        d0 = cs_point_triangle_closest(x0 + 9, x0, x0 + 3, x0 + 6, w);
+    return d0 > need;
+}
+
 /* Continuous test: the first coplanar time at which the pair comes within
  * the proximity tolerance; fills the weights c and a unit normal oriented
  * from the free state's side. */
@@ -733,6 +831,8 @@ static bool pair_collides(const cs_selfcol *sc, const cs_pair *p, bool is_edge, 
     pair_at(sc, p, x, 1, x1);
     for (int k = 0; k < 12; k++)
         dx[k] = x1[k] - x0[k];
+    if (out_of_reach(sc, is_edge, x0, dx))
+        return false;
     int nt = cs_coplanarity_times(x0, x0 + 3, x0 + 6, x0 + 9, dx, dx + 3, dx + 6, dx + 9, times);
     for (int i = 0; i < nt; i++) {
         double xt[12], dist, w[3], s, t;
@@ -793,42 +893,78 @@ static bool pair_collides(const cs_selfcol *sc, const cs_pair *p, bool is_edge, 
     return false;
 }
 
+/* A colliding pair's history, as step A gives its pairs: the side it
+ * started on in the collision-free state (nrm, from pair_collides). An
+ * edge/edge pair keeps it as s0; a point/triangle pair is wound so the
+ * triangle's normal points at that side. Without it the elastic push of
+ * the response reads no history (an edge pair) or pushes a point that came
+ * from behind a triangle through it (a point pair). */
+static void set_history(const cs_selfcol *sc, cs_pair *p, bool is_edge, const double nrm[3])
+{
+    memcpy(p->s0, nrm, sizeof p->s0);
+    if (is_edge)
+        return;
+    const double *x = sc->x_free;
+    double e1[3], e2[3], wn[3];
+    cs_sub(x + 3 * p->v[1], x + 3 * p->v[0], e1);
+    cs_sub(x + 3 * p->v[2], x + 3 * p->v[0], e2);
+    cs_cross(e1, e2, wn);
+    if (cs_dot(wn, nrm) < 0) {
+        int swap = p->v[1];
+        p->v[1] = p->v[2];
+        p->v[2] = swap;
+    }
+}
+
 typedef struct collector {
-    cs_selfcol *sc;
+    const cs_selfcol *sc;
     const cs_par *par;
-    int failed;
+    const double *x;
 } collector;
 
-static void cand_point_triangle(void *ctx, int point, int t)
+static bool make_collision_point_triangle(const void *ctx, int point, int t, cs_pair *out)
 {
-    collector *cl = ctx;
-    cs_selfcol *sc = cl->sc;
-    const int *tri = sc->tri + 3 * t;
+    const collector *cl = ctx;
+    const int *tri = cl->sc->tri + 3 * t;
     if (point == tri[0] || point == tri[1] || point == tri[2])
-        return; /* wings stay: a wing point crossing drags its other triangles through */
+        return false; /* wings stay: a wing point crossing drags its other triangles through */
     int v[4] = {tri[0], tri[1], tri[2], point};
-    if (pair_rank(cl->par, v) == cl->par->rank)
-        cl->failed |= pair_push(&sc->cpt, v, NULL);
+    if (pair_rank(cl->par, v) != cl->par->rank)
+        return false;
+    memcpy(out->v, v, sizeof v);
+    double c[4], nrm[3];
+    if (!pair_collides(cl->sc, out, false, cl->x, c, nrm))
+        return false;
+    set_history(cl->sc, out, false, nrm);
+    return true;
 }
 
-static void cand_edge_edge(void *ctx, int ea, int eb)
+static bool make_collision_edge_edge(const void *ctx, int ea, int eb, cs_pair *out)
 {
-    collector *cl = ctx;
-    cs_selfcol *sc = cl->sc;
-    const int *a = sc->edge + 2 * ea, *b = sc->edge + 2 * eb;
+    const collector *cl = ctx;
+    const int *a = cl->sc->edge + 2 * ea, *b = cl->sc->edge + 2 * eb;
     if (a[0] == b[0] || a[0] == b[1] || a[1] == b[0] || a[1] == b[1])
-        return;
+        return false;
     int v[4] = {a[0], a[1], b[0], b[1]};
-    if (pair_rank(cl->par, v) == cl->par->rank)
-        cl->failed |= pair_push(&sc->cee, v, NULL);
+    if (pair_rank(cl->par, v) != cl->par->rank)
+        return false;
+    memcpy(out->v, v, sizeof v);
+    double c[4], nrm[3];
+    if (!pair_collides(cl->sc, out, true, cl->x, c, nrm))
+        return false;
+    set_history(cl->sc, out, true, nrm);
+    return true;
 }
 
-/* Swept boxes from the free positions to x, and the candidate pairs among
- * primitives (only near changed particles when only_dirty). */
-static void collect_candidates(cs_selfcol *sc, const cs_par *par, const double *x,
-                               bool only_dirty)
+/* Swept boxes from the free positions to x, and the pairs among their
+ * primitives that collide along the trajectories, with their history (only
+ * near changed particles when only_dirty). Returns how many, or -1 when
+ * memory ran out. */
+static long find_collisions(cs_selfcol *sc, const cs_par *par, const double *x,
+                            bool only_dirty)
 {
     double pad = sc->proximity;
+#pragma omp parallel for schedule(static)
     for (int i = 0; i < sc->n; i++) {
         cs_box *b = sc->pbox + i;
         cs_box_empty(b);
@@ -837,6 +973,7 @@ static void collect_candidates(cs_selfcol *sc, const cs_par *par, const double *
         cs_box_thicken(b, pad);
         sc->pdirty[i] = sc->vdirty[i];
     }
+#pragma omp parallel for schedule(static)
     for (int k = 0; k < sc->ne; k++) {
         cs_box *b = sc->ebox + k;
         int i = sc->edge[2 * k], j = sc->edge[2 * k + 1];
@@ -845,6 +982,7 @@ static void collect_candidates(cs_selfcol *sc, const cs_par *par, const double *
         cs_box_add_point(b, sc->pbox[j].hi);
         sc->edirty[k] = sc->vdirty[i] | sc->vdirty[j];
     }
+#pragma omp parallel for schedule(static)
     for (int k = 0; k < sc->nt; k++) {
         cs_box *b = sc->tbox + k;
         const int *t = sc->tri + 3 * k;
@@ -859,11 +997,13 @@ static void collect_candidates(cs_selfcol *sc, const cs_par *par, const double *
     cs_bvh_refit(&sc->etree, sc->ebox, sc->edirty);
     cs_bvh_refit(&sc->ttree, sc->tbox, sc->tdirty);
     sc->cpt.n = sc->cee.n = 0;
-    collector cl = {sc, par, 0};
-    cs_bvh_pairs_for_rank(&sc->ptree, &sc->ttree, sc->pbox, sc->tbox, only_dirty, par->rank,
-                          cand_point_triangle, &cl);
-    cs_bvh_pairs_for_rank(&sc->etree, &sc->etree, sc->ebox, sc->ebox, only_dirty, par->rank,
-                          cand_edge_edge, &cl);
+    collector cl = {sc, par, x};
+    if (find_pairs(sc, &sc->ptree, &sc->ttree, sc->pbox, sc->tbox, only_dirty, par->rank,
+                   make_collision_point_triangle, &cl, &sc->cpt) ||
+        find_pairs(sc, &sc->etree, &sc->etree, sc->ebox, sc->ebox, only_dirty, par->rank,
+                   make_collision_edge_edge, &cl, &sc->cee))
+        return -1;
+    return sc->cpt.n + sc->cee.n;
 }
 
 /* Symmetric 3x3 eigen decomposition by cyclic Jacobi rotations:
@@ -1041,24 +1181,6 @@ static void respond_all(cs_selfcol *sc, const cs_pair_list *pt, const cs_pair_li
         collision_respond(sc, ee->p + j, true, x, u, dv, span, elastic);
 }
 
-/* Keeps the candidates that collide along the pass's trajectories. */
-static long keep_colliding(cs_selfcol *sc, const double *x)
-{
-    long found = 0;
-    for (int l = 0; l < 2; l++) {
-        cs_pair_list *list = l == 0 ? &sc->cpt : &sc->cee;
-        int kept = 0;
-        for (int j = 0; j < list->n; j++) {
-            double c[4], nrm[3];
-            if (pair_collides(sc, list->p + j, l == 1, x, c, nrm))
-                list->p[kept++] = list->p[j];
-        }
-        list->n = kept;
-        found += kept;
-    }
-    return found;
-}
-
 /* Impact zones over all ranks: every rank merges every colliding pair's
  * particles in the same order, so all hold the same zones. Returns 0 or
  * -1. */
@@ -1126,13 +1248,14 @@ long cs_selfcol_collide(cs_sim *sim, double span, int k, bool detect_only)
                 sc->vdirty[i] = memcmp(x + 3 * i, sc->x_pass + 3 * i, 3 * sizeof *x) != 0;
         }
         memcpy(sc->x_pass, x, bytes);
-        collect_candidates(sc, par, x, pass > 0);
+        long found = find_collisions(sc, par, x, pass > 0), found_all = found;
+        if (found < 0)
+            abort(); /* out of memory finding collisions: no collision-free state to keep */
         sc->stats.passes++;
         bool zone_mode = pass >= d->zone_iterations;
         for (int i = 0; i < n; i++)
             for (int c = 0; c < 3; c++)
                 u[3 * i + c] = (x[3 * i + c] - sc->x_free[3 * i + c]) / span;
-        long found = keep_colliding(sc, x), found_all = found;
         cs_par_sum_long(par, &found_all, 1);
         if (pass == 0)
             first_pass = found_all;

@@ -62,6 +62,12 @@ typedef struct cs_selfcol {
     cs_pair_list bpt, bee;     /* boundary repulsion pairs this rank processes */
     cs_halo bhalo;             /* their particles: owners <-> this rank */
     double *x_pass;            /* positions at the last step C pass's start */
+    /* traversal scratch (find_pairs): candidates, the pairs made of them */
+    cs_bvh_work bvh_work;
+    cs_index_pairs candidates;
+    cs_pair *made;
+    unsigned char *keep;
+    int made_capacity;
     cs_selfcol_stats stats;
     size_t bytes;
 } cs_selfcol;
