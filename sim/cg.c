@@ -112,10 +112,9 @@ int cs_cg_solve(cs_sim *sim, double *v0, const double *rhs, double *v)
         int i = own[r];
         double acc[3] = {0, 0, 0};
         for (int e = s->row_start[r]; e < s->row_start[r + 1]; e++) {
-            int k = s->row_spring[e];
-            const double *u = s->direction + 3 * k;
+            const double *u = s->row_direction + 3 * e;
             for (int d = 0; d < 3; d++)
-                acc[d] += s->damping[k] * u[d] * u[d];
+                acc[d] += s->row_damping[e] * u[d] * u[d];
         }
         for (int d = 0; d < 3; d++) {
             double wind = 0;

@@ -538,8 +538,7 @@ int cs_sim_step(cs_sim *sim, double dt)
         if (!sim->is_free[i])
             for (int d = 0; d < 3; d++)
                 sim->v0[3 * i + d] = (sim->script_x[3 * i + d] - sim->x[3 * i + d]) / dt;
-    explicit_forces(sim, sim->x);
-    cs_springs_prepare(&sim->springs, sim->x);
+    explicit_forces(sim, sim->x); /* prepares the springs' directions at x^n too */
     momentum_rhs(sim, sim->v);
     sim->cg_iterations += cs_cg_solve(sim, sim->v0, sim->rhs, sim->v_half);
     STAGE_END(sim, CS_STAGE_VELOCITY_HALF);
@@ -590,8 +589,7 @@ int cs_sim_step(cs_sim *sim, double dt)
     CS_FOR_LOCAL(par, i) /* x^(n+1/2), reusing v_half */
         for (int d = 0; d < 3; d++)
             sim->v_half[3 * i + d] = 0.5 * (sim->x_prev[3 * i + d] + sim->x[3 * i + d]);
-    explicit_forces(sim, sim->v_half);
-    cs_springs_prepare(&sim->springs, sim->v_half);
+    explicit_forces(sim, sim->v_half); /* and at x^(n+1/2) */
     momentum_rhs(sim, sim->v_star);
     double *v_p = sim->v0; /* v0 is free again */
     copy_ranges(par->own, par->nown, sim->cg.b, sim->v_star);

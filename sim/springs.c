@@ -126,15 +126,22 @@ int cs_springs_add_mesh(cs_springs *s, int offset, int nv, int nt, const int *tr
 int cs_springs_index(cs_springs *s, int nrows, const int *particles, int nparticles)
 {
     free(s->row_start);
-    free(s->row_spring);
     free(s->row_other);
+    free(s->row_damping);
+    free(s->row_direction);
+    free(s->row_magnitude);
+    free(s->row_of_end);
     s->nrows = nrows;
+    s->row_damping = malloc(sizeof(double) * (2 * (size_t)s->n + 1));
+    s->row_direction = malloc(sizeof(double) * 3 * (2 * (size_t)s->n + 1));
+    s->row_magnitude = malloc(sizeof(double) * (2 * (size_t)s->n + 1));
+    s->row_of_end = malloc(sizeof(int) * (2 * (size_t)s->n + 1));
     s->row_particle = particles;
     s->row_start = calloc((size_t)nrows + 1, sizeof *s->row_start);
-    s->row_spring = malloc(sizeof *s->row_spring * (2 * (size_t)s->n + 1));
     s->row_other = malloc(sizeof *s->row_other * (2 * (size_t)s->n + 1));
     int *row_of = malloc(sizeof *row_of * ((size_t)nparticles + 1));
-    if (!s->row_start || !s->row_spring || !s->row_other || !row_of) {
+    if (!s->row_start || !s->row_other || !row_of || !s->row_damping ||
+        !s->row_direction || !s->row_magnitude || !s->row_of_end) {
         free(row_of);
         return -1;
     }
@@ -158,9 +165,10 @@ int cs_springs_index(cs_springs *s, int nrows, const int *particles, int npartic
     for (int k = 0; k < s->n; k++) /* ascending k: each row in spring order */
         for (int e = 0; e < 2; e++) {
             int r = row_of[s->ends[2 * k + e]];
+            s->row_of_end[2 * k + e] = r < 0 ? -1 : fill[r];
             if (r < 0)
                 continue;
-            s->row_spring[fill[r]] = k;
+            s->row_damping[fill[r]] = s->damping[k];
             s->row_other[fill[r]++] = s->ends[2 * k + 1 - e];
         }
     free(fill);
@@ -176,8 +184,11 @@ void cs_springs_free(cs_springs *s)
     free(s->damping);
     free(s->direction);
     free(s->row_start);
-    free(s->row_spring);
     free(s->row_other);
+    free(s->row_damping);
+    free(s->row_direction);
+    free(s->row_magnitude);
+    free(s->row_of_end);
     memset(s, 0, sizeof *s);
 }
 
@@ -186,26 +197,6 @@ void cs_springs_free(cs_springs *s)
  * stretched, and (v_other - v_self) . u_hat damps their approach. The
  * negations this swaps in are exact, so gathering reproduces the
  * scatter's numbers bit for bit. */
-void cs_springs_add_elastic(const cs_springs *s, const double *x, double *f)
-{
-#pragma omp parallel for schedule(static)
-    for (int r = 0; r < s->nrows; r++) {
-        int i = s->row_particle[r];
-        double acc[3] = {f[3 * i], f[3 * i + 1], f[3 * i + 2]};
-        for (int e = s->row_start[r]; e < s->row_start[r + 1]; e++) {
-            int k = s->row_spring[e];
-            double u[3];
-            cs_sub(x + 3 * s->row_other[e], x + 3 * i, u);
-            double l = cs_norm(u);
-            if (!(l > 0))
-                continue; /* coincident: no direction to push along */
-            double mag = s->stiffness[k] * (l / s->rest_length[k] - 1.0) / l;
-            cs_axpy(mag, u, acc);
-        }
-        memcpy(f + 3 * i, acc, sizeof acc);
-    }
-}
-
 void cs_springs_prepare(cs_springs *s, const double *x)
 {
 #pragma omp parallel for schedule(static)
@@ -214,12 +205,40 @@ void cs_springs_prepare(cs_springs *s, const double *x)
         double *u = s->direction + 3 * k;
         cs_sub(x + 3 * j, x + 3 * i, u);
         double l = cs_norm(u);
+        /* coincident: no direction to push along */
+        double mag = l > 0 ? s->stiffness[k] * (l / s->rest_length[k] - 1.0) / l : 0;
         if (l > 0) {
             for (int d = 0; d < 3; d++)
                 u[d] /= l;
         } else {
             u[0] = u[1] = u[2] = 0;
         }
+        for (int e = 0; e < 2; e++) {
+            int at = s->row_of_end[2 * k + e];
+            if (at < 0)
+                continue;
+            memcpy(s->row_direction + 3 * at, u, 3 * sizeof *u);
+            s->row_magnitude[at] = mag;
+        }
+    }
+}
+
+void cs_springs_add_elastic(cs_springs *s, const double *x, double *f)
+{
+    cs_springs_prepare(s, x);
+#pragma omp parallel for schedule(static)
+    for (int r = 0; r < s->nrows; r++) {
+        int i = s->row_particle[r];
+        double acc[3] = {f[3 * i], f[3 * i + 1], f[3 * i + 2]};
+        for (int e = s->row_start[r]; e < s->row_start[r + 1]; e++) {
+            double mag = s->row_magnitude[e];
+            if (mag == 0)
+                continue; /* at rest length, or coincident ends */
+            double u[3];
+            cs_sub(x + 3 * s->row_other[e], x + 3 * i, u);
+            cs_axpy(mag, u, acc);
+        }
+        memcpy(f + 3 * i, acc, sizeof acc);
     }
 }
 
@@ -240,10 +259,9 @@ void cs_springs_add_damping_diagonal(const cs_springs *s, double *diag)
     for (int r = 0; r < s->nrows; r++) {
         int i = s->row_particle[r];
         for (int e = s->row_start[r]; e < s->row_start[r + 1]; e++) {
-            int k = s->row_spring[e];
-            const double *u = s->direction + 3 * k;
+            const double *u = s->row_direction + 3 * e;
             for (int d = 0; d < 3; d++)
-                diag[3 * i + d] += s->damping[k] * u[d] * u[d];
+                diag[3 * i + d] += s->row_damping[e] * u[d] * u[d];
         }
     }
 }

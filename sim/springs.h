@@ -22,14 +22,20 @@ typedef struct cs_springs {
     int nedge;           /* the first nedge springs are edge springs */
     int skipped;         /* degenerate (zero rest length) springs left out */
     /* Each updated particle's springs (cs_springs_index), in spring order:
-     * row r is particle row_particle[r], its springs row_spring[row_start[r]
-     * .. row_start[r + 1]) with far ends row_other[...]. The kernels gather
+     * row r is particle row_particle[r], its springs the entries
+     * [row_start[r], row_start[r + 1]) with far ends row_other[...]. The kernels gather
      * per particle instead of scattering per spring, so threads never write
      * the same particle and every particle sums its springs in the same
      * order at any thread count (the order the scatter loop had). */
     int nrows;
     const int *row_particle;
-    int *row_start, *row_spring, *row_other;
+    int *row_start, *row_other;
+    /* per row entry, so the gathers stream: the spring's damping (fixed),
+     * and from cs_springs_prepare its u_hat and elastic magnitude
+     * E (l/L0 - 1) / l; row_of_end[2k + e] is where spring k's end e sits
+     * in the rows (-1 where that end is not a row's particle) */
+    double *row_damping, *row_direction, *row_magnitude;
+    int *row_of_end;
 } cs_springs;
 
 /* Appends the edge and bending springs of a triangle mesh whose vertices are
@@ -49,10 +55,9 @@ static inline void cs_springs_damping_row(const cs_springs *s, int r, const doub
 {
     const double *vi = v + 3 * s->row_particle[r];
     for (int e = s->row_start[r]; e < s->row_start[r + 1]; e++) {
-        int k = s->row_spring[e];
-        const double *u = s->direction + 3 * k, *vo = v + 3 * s->row_other[e];
+        const double *u = s->row_direction + 3 * e, *vo = v + 3 * s->row_other[e];
         double rel[3] = {vo[0] - vi[0], vo[1] - vi[1], vo[2] - vi[2]};
-        double mag = s->damping[k] * (rel[0] * u[0] + rel[1] * u[1] + rel[2] * u[2]);
+        double mag = s->row_damping[e] * (rel[0] * u[0] + rel[1] * u[1] + rel[2] * u[2]);
         acc[0] += mag * u[0];
         acc[1] += mag * u[1];
         acc[2] += mag * u[2];
@@ -65,10 +70,12 @@ int cs_springs_index(cs_springs *s, int nrows, const int *particles, int npartic
 
 /* The kernels below write the rows' particles only (OpenMP threads share
  * them). */
-/* Elastic forces only (the explicit part), added into f. */
-void cs_springs_add_elastic(const cs_springs *s, const double *x, double *f);
-/* Stores u_hat of every spring at positions x for the damping operator. */
+/* Stores u_hat and the elastic magnitude of every spring at positions x,
+ * for the damping operator and the elastic forces. */
 void cs_springs_prepare(cs_springs *s, const double *x);
+/* Elastic forces only (the explicit part) at positions x, added into f;
+ * prepares at x first (one pass over the springs serves both). */
+void cs_springs_add_elastic(cs_springs *s, const double *x, double *f);
 /* out += D v, the damping force (D is the velocity Jacobian, symmetric
  * negative semi-definite), with the directions from cs_springs_prepare. */
 void cs_springs_add_damping(const cs_springs *s, const double *v, double *out);
