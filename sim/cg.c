@@ -43,6 +43,14 @@ static inline void project_row(const cs_sim *sim, int i, double a[3])
     }
 }
 
+/* out = the stored symmetric 3 x 3 inverse (xx yy zz xy xz yz) times r */
+static inline void precondition(const double inv[6], const double r[3], double out[3])
+{
+    out[0] = inv[0] * r[0] + inv[3] * r[1] + inv[4] * r[2];
+    out[1] = inv[3] * r[0] + inv[1] * r[1] + inv[5] * r[2];
+    out[2] = inv[4] * r[0] + inv[5] * r[1] + inv[2] * r[2];
+}
+
 void cs_damping_apply(const cs_sim *sim, const double *v, double *out)
 {
     const int *own = cs_par_owned(sim->par);
@@ -98,7 +106,7 @@ static double reduce(cs_sim *sim, const double *sum, const double *max, double *
  * owned. The stopping test is the residual in velocity units, max over
  * particles of |r_i| / m_i: a maximum is exact, so every rank and thread
  * count stops at the same iteration. */
-int cs_cg_solve(cs_sim *sim, double *v0, const double *rhs, double *v)
+int cs_cg_solve(cs_sim *sim, double *v0, const double *rhs, double *v, double *warm)
 {
     cs_par *par = sim->par;
     cs_cg_work *w = &sim->cg;
@@ -106,30 +114,56 @@ int cs_cg_solve(cs_sim *sim, double *v0, const double *rhs, double *v)
     const cs_springs *s = &sim->springs;
     double *part_sum = w->partial, *part_max = w->partial + block_count(par);
 
-    /* Jacobi preconditioner: diagonal of M - h D */
+    /* Block Jacobi preconditioner: the inverse of each particle's 3 x 3
+     * diagonal block of M - h D (the damping acts along spring directions,
+     * which a diagonal alone misses), stored as its 6 distinct entries */
 #pragma omp parallel for schedule(static)
     for (int r = 0; r < par->nowned; r++) {
         int i = own[r];
-        double acc[3] = {0, 0, 0};
+        double B[6] = {0, 0, 0, 0, 0, 0}; /* xx yy zz xy xz yz of D's block, negated */
         for (int e = s->row_start[r]; e < s->row_start[r + 1]; e++) {
             const double *u = s->row_direction + 3 * e;
-            for (int d = 0; d < 3; d++)
-                acc[d] += s->row_damping[e] * u[d] * u[d];
+            double c = s->row_damping[e];
+            B[0] += c * u[0] * u[0];
+            B[1] += c * u[1] * u[1];
+            B[2] += c * u[2] * u[2];
+            B[3] += c * u[0] * u[1];
+            B[4] += c * u[0] * u[2];
+            B[5] += c * u[1] * u[2];
         }
-        for (int d = 0; d < 3; d++) {
-            double wind = 0;
-            if (sim->wind_normal) {
-                double nd = sim->wind_normal[3 * i + d];
-                wind = sim->def.wind.drag * sim->wind_area[i] * nd * nd;
-            }
-            w->diag[3 * i + d] = sim->mass[i] + sim->h * (acc[d] + wind);
+        if (sim->wind_normal) {
+            const double *nd = sim->wind_normal + 3 * i;
+            double c = sim->def.wind.drag * sim->wind_area[i];
+            B[0] += c * nd[0] * nd[0];
+            B[1] += c * nd[1] * nd[1];
+            B[2] += c * nd[2] * nd[2];
+            B[3] += c * nd[0] * nd[1];
+            B[4] += c * nd[0] * nd[2];
+            B[5] += c * nd[1] * nd[2];
         }
+        double m = sim->mass[i], h = sim->h;
+        double a = m + h * B[0], b = m + h * B[1], cz = m + h * B[2];
+        double xy = h * B[3], xz = h * B[4], yz = h * B[5];
+        /* inverse by cofactors; the block is symmetric positive definite */
+        double c00 = b * cz - yz * yz, c01 = xz * yz - xy * cz, c02 = xy * yz - xz * b;
+        double det = a * c00 + xy * c01 + xz * c02;
+        double *inv = w->block + 6 * i;
+        inv[0] = c00 / det;
+        inv[1] = (a * cz - xz * xz) / det;
+        inv[2] = (a * b - xy * xy) / det;
+        inv[3] = c01 / det;
+        inv[4] = c02 / det;
+        inv[5] = (xy * xz - a * yz) / det;
     }
 
     /* Start from the explicit update z = P M^-1 r0, exact when the damping
      * does no work (rigid motion). Starting from z = 0 would let a loose
      * tolerance (Table 1's 1e-3 m/s) swallow a step's whole acceleration
-     * when dt is small: the solve must resolve only the damping response. */
+     * when dt is small: the solve must resolve only the damping response.
+     * With warm, add the damping response of this solve's previous call
+     * (projected by today's contacts): it changes little from one step to
+     * the next, so CG starts near the answer (the stopping test is the
+     * same, only fewer iterations reach it). */
     cs_halo_forward(par, &par->ghosts, v0, 3);
 #pragma omp parallel for schedule(static)
     for (int r = 0; r < par->nowned; r++) {
@@ -139,8 +173,12 @@ int cs_cg_solve(cs_sim *sim, double *v0, const double *rhs, double *v)
         for (int d = 0; d < 3; d++)
             ri[d] = rhs[3 * i + d] - q[d];
         project_row(sim, i, ri);
+        double *wi = warm ? warm + 3 * i : NULL;
+        if (wi)
+            project_row(sim, i, wi);
         for (int d = 0; d < 3; d++) {
-            w->z[3 * i + d] = ri[d] / sim->mass[i];
+            w->explicit_z[3 * i + d] = ri[d] / sim->mass[i];
+            w->z[3 * i + d] = w->explicit_z[3 * i + d] + (wi ? wi[d] : 0);
             w->y[3 * i + d] = v0[3 * i + d] + w->z[3 * i + d];
         }
     }
@@ -156,8 +194,7 @@ int cs_cg_solve(cs_sim *sim, double *v0, const double *rhs, double *v)
             for (int d = 0; d < 3; d++)
                 ri[d] = rhs[3 * i + d] - q[d];
             project_row(sim, i, ri);
-            for (int d = 0; d < 3; d++)
-                pi[d] = ri[d] / w->diag[3 * i + d];
+            precondition(w->block + 6 * i, ri, pi);
             project_row(sim, i, pi);
             for (int d = 0; d < 3; d++)
                 sum += ri[d] * pi[d];
@@ -196,8 +233,8 @@ int cs_cg_solve(cs_sim *sim, double *v0, const double *rhs, double *v)
                     int k = 3 * i + d;
                     w->z[k] += alpha * w->p[k];
                     w->r[k] -= alpha * w->q[k];
-                    yi[d] = w->r[k] / w->diag[k];
                 }
+                precondition(w->block + 6 * i, ri, yi);
                 project_row(sim, i, yi);
                 for (int d = 0; d < 3; d++)
                     sum += ri[d] * yi[d];
@@ -222,6 +259,8 @@ int cs_cg_solve(cs_sim *sim, double *v0, const double *rhs, double *v)
         for (int d = 0; d < 3; d++) {
             int k = 3 * own[r] + d;
             v[k] = v0[k] + w->z[k];
+            if (warm)
+                warm[k] = w->z[k] - w->explicit_z[k];
         }
     return it;
 }

@@ -31,6 +31,9 @@ enum { CS_BLOCK = 1024 };
 
 typedef struct cs_cg_work {
     double *z, *r, *y, *p, *q, *diag, *b;
+    double *explicit_z;          /* the explicit update CG starts from */
+    double *block;               /* 6 per particle: the preconditioner's 3 x 3 inverse */
+    double *warm_half, *warm_full; /* last damping responses of B.1 and B.5 */
     double *partial;  /* 2 per block: a partial sum and a partial maximum */
 } cs_cg_work;
 
@@ -86,8 +89,10 @@ int cs_sort_unique_pairs(int *pairs, int n);
 /* cg.c: solves P (M - h D) P z = P (rhs - (M - h D) v0) for v = v0 + z,
  * where P projects out fixed velocities and contact normals, over all
  * ranks (v0's ghosts are refreshed first; v is written where owned).
+ * warm (3 per particle, or NULL) holds the damping response of the last
+ * solve of the same kind, added to the start, and receives this one's.
  * Returns the iteration count, the same on every rank. */
-int cs_cg_solve(cs_sim *sim, double *v0, const double *rhs, double *v);
+int cs_cg_solve(cs_sim *sim, double *v0, const double *rhs, double *v, double *warm);
 /* out = (M - h D) v, D the damping (and wind drag) velocity Jacobian. */
 void cs_system_apply(const cs_sim *sim, const double *v, double *out);
 /* out += D v (damping plus implicit wind drag). */

@@ -211,14 +211,16 @@ cs_sim *cs_sim_create(const cs_sim_def *def, char *err, size_t errlen)
     sim->force = alloc3(n);
     sim->v0 = alloc3(n);
     sim->rhs = alloc3(n);
-    double **cg[] = {&sim->cg.z, &sim->cg.r, &sim->cg.y, &sim->cg.p,
-                     &sim->cg.q, &sim->cg.diag, &sim->cg.b};
+    double **cg[] = {&sim->cg.z, &sim->cg.r, &sim->cg.y, &sim->cg.p, &sim->cg.q,
+                     &sim->cg.diag, &sim->cg.b, &sim->cg.explicit_z, &sim->cg.warm_half,
+                     &sim->cg.warm_full};
     bool ok = sim->x && sim->v && sim->mass && sim->is_free && sim->mode && sim->cloths &&
               sim->x_prev && sim->v_half && sim->v_star && sim->v_next && sim->force &&
               sim->v0 && sim->rhs;
     for (size_t k = 0; k < sizeof cg / sizeof *cg && ok; k++)
         ok = (*cg[k] = alloc3(n)) != NULL;
     ok = ok && (sim->cg.partial = calloc(2 * ((size_t)n / CS_BLOCK + 1), sizeof(double)));
+    ok = ok && (sim->cg.block = calloc(6 * (size_t)n + 6, sizeof(double)));
     if (!ok)
         goto nomem;
 
@@ -400,7 +402,8 @@ void cs_sim_destroy(cs_sim *sim)
                         sim->v_next, sim->force, sim->v0, sim->rhs, sim->script_x,
                         sim->script_v, sim->contact_normal, sim->wind_normal, sim->wind_area, sim->v_rewind,
                         sim->cg.z, sim->cg.r, sim->cg.y, sim->cg.p, sim->cg.q, sim->cg.diag,
-                        sim->cg.b, sim->cg.partial};
+                        sim->cg.b, sim->cg.partial, sim->cg.explicit_z, sim->cg.warm_half,
+                        sim->cg.warm_full, sim->cg.block};
     for (size_t k = 0; k < sizeof arrays / sizeof *arrays; k++)
         free(arrays[k]);
     free(sim->is_free);
@@ -540,7 +543,7 @@ int cs_sim_step(cs_sim *sim, double dt)
                 sim->v0[3 * i + d] = (sim->script_x[3 * i + d] - sim->x[3 * i + d]) / dt;
     explicit_forces(sim, sim->x); /* prepares the springs' directions at x^n too */
     momentum_rhs(sim, sim->v);
-    sim->cg_iterations += cs_cg_solve(sim, sim->v0, sim->rhs, sim->v_half);
+    sim->cg_iterations += cs_cg_solve(sim, sim->v0, sim->rhs, sim->v_half, sim->cg.warm_half);
     STAGE_END(sim, CS_STAGE_VELOCITY_HALF);
 
     /* B.2: repulsions change only the velocity that moves the positions */
@@ -593,7 +596,7 @@ int cs_sim_step(cs_sim *sim, double dt)
     momentum_rhs(sim, sim->v_star);
     double *v_p = sim->v0; /* v0 is free again */
     copy_ranges(par->own, par->nown, sim->cg.b, sim->v_star);
-    sim->cg_iterations += cs_cg_solve(sim, sim->cg.b, sim->rhs, v_p);
+    sim->cg_iterations += cs_cg_solve(sim, sim->cg.b, sim->rhs, v_p, sim->cg.warm_full);
     if (bodies && sim->def.friction_method == CS_FRICTION_IMPROVED) {
         copy_ranges(par->local, par->nlocal, sim->v_next, sim->force);
         cs_halo_forward(par, &par->ghosts, v_p, 3);
