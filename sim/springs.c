@@ -16,18 +16,16 @@ static int reserve(cs_springs *s, int extra)
     int *ends = realloc(s->ends, sizeof *ends * 2 * (size_t)cap);
     if (ends)
         s->ends = ends;
-    double **arrays[3] = {&s->rest_length, &s->stiffness, &s->damping};
+    double **arrays[4] = {&s->rest_length, &s->stiffness, &s->damping, &s->inv_rest_length};
     int ok = ends != NULL;
-    for (int k = 0; k < 3 && ok; k++) {
+    for (int k = 0; k < 4 && ok; k++) {
         double *a = realloc(*arrays[k], sizeof *a * (size_t)cap);
         if (a)
             *arrays[k] = a;
         ok = a != NULL;
     }
-    double *dir = ok ? realloc(s->direction, sizeof *dir * 3 * (size_t)cap) : NULL;
-    if (!dir)
+    if (!ok)
         return -1;
-    s->direction = dir;
     s->capacity = cap;
     return 0;
 }
@@ -47,9 +45,9 @@ static void push(cs_springs *s, int i, int j, const double *x, const double *mas
     s->ends[2 * k] = i;
     s->ends[2 * k + 1] = j;
     s->rest_length[k] = L0;
+    s->inv_rest_length[k] = 1.0 / L0;
     s->stiffness[k] = E;
     s->damping[k] = xi * 2.0 * sqrt(E * m_reduced / L0);
-    memcpy(s->direction + 3 * k, u, sizeof u);
 }
 
 /* An undirected mesh edge with the triangle it came from. */
@@ -130,18 +128,20 @@ int cs_springs_index(cs_springs *s, int nrows, const int *particles, int npartic
     free(s->row_damping);
     free(s->row_direction);
     free(s->row_magnitude);
-    free(s->row_of_end);
+    free(s->row_stiffness);
+    free(s->row_inv_rest_length);
     s->nrows = nrows;
     s->row_damping = malloc(sizeof(double) * (2 * (size_t)s->n + 1));
     s->row_direction = malloc(sizeof(double) * 3 * (2 * (size_t)s->n + 1));
     s->row_magnitude = malloc(sizeof(double) * (2 * (size_t)s->n + 1));
-    s->row_of_end = malloc(sizeof(int) * (2 * (size_t)s->n + 1));
+    s->row_stiffness = malloc(sizeof(double) * (2 * (size_t)s->n + 1));
+    s->row_inv_rest_length = malloc(sizeof(double) * (2 * (size_t)s->n + 1));
     s->row_particle = particles;
     s->row_start = calloc((size_t)nrows + 1, sizeof *s->row_start);
     s->row_other = malloc(sizeof *s->row_other * (2 * (size_t)s->n + 1));
     int *row_of = malloc(sizeof *row_of * ((size_t)nparticles + 1));
     if (!s->row_start || !s->row_other || !row_of || !s->row_damping ||
-        !s->row_direction || !s->row_magnitude || !s->row_of_end) {
+        !s->row_direction || !s->row_magnitude || !s->row_stiffness || !s->row_inv_rest_length) {
         free(row_of);
         return -1;
     }
@@ -165,10 +165,11 @@ int cs_springs_index(cs_springs *s, int nrows, const int *particles, int npartic
     for (int k = 0; k < s->n; k++) /* ascending k: each row in spring order */
         for (int e = 0; e < 2; e++) {
             int r = row_of[s->ends[2 * k + e]];
-            s->row_of_end[2 * k + e] = r < 0 ? -1 : fill[r];
             if (r < 0)
                 continue;
             s->row_damping[fill[r]] = s->damping[k];
+            s->row_stiffness[fill[r]] = s->stiffness[k];
+            s->row_inv_rest_length[fill[r]] = s->inv_rest_length[k];
             s->row_other[fill[r]++] = s->ends[2 * k + 1 - e];
         }
     free(fill);
@@ -180,15 +181,16 @@ void cs_springs_free(cs_springs *s)
 {
     free(s->ends);
     free(s->rest_length);
+    free(s->inv_rest_length);
     free(s->stiffness);
     free(s->damping);
-    free(s->direction);
     free(s->row_start);
     free(s->row_other);
     free(s->row_damping);
     free(s->row_direction);
     free(s->row_magnitude);
-    free(s->row_of_end);
+    free(s->row_stiffness);
+    free(s->row_inv_rest_length);
     memset(s, 0, sizeof *s);
 }
 
@@ -199,26 +201,22 @@ void cs_springs_free(cs_springs *s)
  * scatter's numbers bit for bit. */
 void cs_springs_prepare(cs_springs *s, const double *x)
 {
+    /* every row entry from its own end, so the writes stream: the far end's
+     * entry gets -u exactly, which the gathers turn into the same sums */
 #pragma omp parallel for schedule(static)
-    for (int k = 0; k < s->n; k++) {
-        int i = s->ends[2 * k], j = s->ends[2 * k + 1];
-        double *u = s->direction + 3 * k;
-        cs_sub(x + 3 * j, x + 3 * i, u);
-        double l = cs_norm(u);
-        /* coincident: no direction to push along */
-        double mag = l > 0 ? s->stiffness[k] * (l / s->rest_length[k] - 1.0) / l : 0;
-        if (l > 0) {
+    for (int r = 0; r < s->nrows; r++) {
+        const double *xi = x + 3 * s->row_particle[r];
+        for (int e = s->row_start[r]; e < s->row_start[r + 1]; e++) {
+            double *u = s->row_direction + 3 * e;
+            cs_sub(x + 3 * s->row_other[e], xi, u);
+            double l = cs_norm(u);
+            /* one division: E (l / L0 - 1) / l = E / L0 - E / l, and u / l
+             * (coincident ends: no direction to push along) */
+            double inv = l > 0 ? 1.0 / l : 0;
+            s->row_magnitude[e] =
+                l > 0 ? s->row_stiffness[e] * (s->row_inv_rest_length[e] - inv) : 0;
             for (int d = 0; d < 3; d++)
-                u[d] /= l;
-        } else {
-            u[0] = u[1] = u[2] = 0;
-        }
-        for (int e = 0; e < 2; e++) {
-            int at = s->row_of_end[2 * k + e];
-            if (at < 0)
-                continue;
-            memcpy(s->row_direction + 3 * at, u, 3 * sizeof *u);
-            s->row_magnitude[at] = mag;
+                u[d] *= inv;
         }
     }
 }
@@ -295,6 +293,7 @@ void cs_springs_keep_touching(cs_springs *s, const int *owner, int rank)
         s->ends[2 * kept] = i;
         s->ends[2 * kept + 1] = j;
         s->rest_length[kept] = s->rest_length[k];
+        s->inv_rest_length[kept] = s->inv_rest_length[k];
         s->stiffness[kept] = s->stiffness[k];
         s->damping[kept] = s->damping[k];
         kept_edge += k < s->nedge;

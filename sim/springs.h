@@ -16,9 +16,9 @@ typedef struct cs_springs {
     int n, capacity;
     int *ends;           /* 2 per spring: i, j (global particle indices) */
     double *rest_length; /* L0 */
+    double *inv_rest_length; /* 1 / L0 */
     double *stiffness;   /* E, N */
     double *damping;     /* d, N s / m */
-    double *direction;   /* 3 per spring: u_hat at the last cs_springs_prepare */
     int nedge;           /* the first nedge springs are edge springs */
     int skipped;         /* degenerate (zero rest length) springs left out */
     /* Each updated particle's springs (cs_springs_index), in spring order:
@@ -30,12 +30,11 @@ typedef struct cs_springs {
     int nrows;
     const int *row_particle;
     int *row_start, *row_other;
-    /* per row entry, so the gathers stream: the spring's damping (fixed),
-     * and from cs_springs_prepare its u_hat and elastic magnitude
-     * E (l/L0 - 1) / l; row_of_end[2k + e] is where spring k's end e sits
-     * in the rows (-1 where that end is not a row's particle) */
-    double *row_damping, *row_direction, *row_magnitude;
-    int *row_of_end;
+    /* per row entry, so the gathers stream: the spring's constants, and
+     * from cs_springs_prepare its u_hat seen from the row's particle and
+     * its elastic magnitude E (l/L0 - 1) / l */
+    double *row_damping, *row_stiffness, *row_inv_rest_length;
+    double *row_direction, *row_magnitude;
 } cs_springs;
 
 /* Appends the edge and bending springs of a triangle mesh whose vertices are
