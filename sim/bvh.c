@@ -62,9 +62,11 @@ int cs_bvh_build(cs_bvh *t, int nprims, const cs_box *pb)
     t->first = calloc((size_t)cap, sizeof *t->first);
     t->count = calloc((size_t)cap, sizeof *t->count);
     t->order = calloc((size_t)nprims + 1, sizeof *t->order);
+    t->leaf_box = calloc((size_t)nprims + 1, sizeof *t->leaf_box);
     t->dirty = calloc((size_t)cap, 1);
     builder b = {t, pb, calloc(3 * (size_t)nprims + 3, sizeof(double)), 0};
-    if (!t->box || !t->child || !t->first || !t->count || !t->order || !t->dirty || !b.centroid) {
+    if (!t->box || !t->child || !t->first || !t->count || !t->order || !t->dirty ||
+        !t->leaf_box || !b.centroid) {
         free(b.centroid);
         cs_bvh_free(t);
         return -1;
@@ -88,6 +90,7 @@ void cs_bvh_free(cs_bvh *t)
     free(t->first);
     free(t->count);
     free(t->order);
+    free(t->leaf_box);
     free(t->dirty);
     free(t->rank_lo);
     free(t->rank_hi);
@@ -104,6 +107,7 @@ void cs_bvh_refit(cs_bvh *t, const cs_box *pb, const unsigned char *prim_dirty)
             unsigned char dirty = 0;
             for (int k = t->first[node]; k < t->first[node] + t->count[node]; k++) {
                 int p = t->order[k];
+                t->leaf_box[k] = pb[p];
                 cs_box_add_point(b, pb[p].lo);
                 cs_box_add_point(b, pb[p].hi);
                 dirty |= prim_dirty ? prim_dirty[p] : 0;
@@ -121,7 +125,6 @@ void cs_bvh_refit(cs_bvh *t, const cs_box *pb, const unsigned char *prim_dirty)
 
 typedef struct traversal {
     const cs_bvh *A, *B;
-    const cs_box *box_a, *box_b;
     bool self, only_dirty;
     int rank;
     int depth;            /* planning: node pairs this deep become tasks */
@@ -150,12 +153,12 @@ static void leaf_pairs(traversal *tr, int i, int j)
     const cs_bvh *A = tr->A, *B = tr->B;
     for (int ka = A->first[i]; ka < A->first[i] + A->count[i]; ka++) {
         int a = A->order[ka];
-        const cs_box *ba = tr->box_a + a;
+        const cs_box *ba = A->leaf_box + ka;
         int kb0 = (tr->self && i == j) ? ka + 1 : B->first[j];
         for (int kb = kb0; kb < B->first[j] + B->count[j]; kb++) {
-            int b = B->order[kb];
-            if (!cs_box_overlap(ba, tr->box_b + b))
+            if (!cs_box_overlap(ba, B->leaf_box + kb))
                 continue;
+            int b = B->order[kb];
             bool ok = tr->self && a > b ? push_pair(tr->out, b, a) : push_pair(tr->out, a, b);
             tr->failed |= !ok;
         }
@@ -242,14 +245,14 @@ static void descend(traversal *tr, int i, int j, int depth)
  * so uneven ones even out. */
 enum { TASK_DEPTH = 8 };
 
-int cs_bvh_collect(const cs_bvh *A, const cs_bvh *B, const cs_box *box_a, const cs_box *box_b,
-                   bool only_dirty, int rank, cs_bvh_work *w, cs_index_pairs *out)
+int cs_bvh_collect(const cs_bvh *A, const cs_bvh *B, bool only_dirty, int rank, cs_bvh_work *w,
+                   cs_index_pairs *out)
 {
     out->n = 0;
     w->ntasks = 0;
     if (A->nnodes == 0 || B->nnodes == 0)
         return 0;
-    traversal plan = {A, B, box_a, box_b, A == B, only_dirty, rank, TASK_DEPTH, w, NULL, 0};
+    traversal plan = {A, B, A == B, only_dirty, rank, TASK_DEPTH, w, NULL, 0};
     descend(&plan, 0, 0, 0);
     if (plan.failed)
         return -1;
@@ -264,7 +267,7 @@ int cs_bvh_collect(const cs_bvh *A, const cs_bvh *B, const cs_box *box_a, const 
     int failed = 0;
 #pragma omp parallel for schedule(dynamic, 1) reduction(| : failed)
     for (int t = 0; t < w->ntasks; t++) {
-        traversal tr = {A, B, box_a, box_b, A == B, only_dirty, rank, 0, NULL, w->found + t, 0};
+        traversal tr = {A, B, A == B, only_dirty, rank, 0, NULL, w->found + t, 0};
         tr.out->n = 0;
         descend(&tr, w->task[2 * t], w->task[2 * t + 1], 0);
         failed |= tr.failed;

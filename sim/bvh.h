@@ -21,6 +21,7 @@ typedef struct cs_bvh {
     int *child;           /* 2 per node: left, right; -1 for a leaf */
     int *first, *count;   /* leaf: primitives order[first .. first+count) */
     int *order;           /* primitive ids in leaf order */
+    cs_box *leaf_box;     /* their boxes in leaf order, from the last refit */
     unsigned char *dirty; /* per node, from cs_bvh_refit's dirty input */
     int *rank_lo, *rank_hi; /* per node: the ranks its primitives go to */
 } cs_bvh;
@@ -53,12 +54,13 @@ void cs_bvh_work_free(cs_bvh_work *w);
  * A == B each unordered pair once, as a < b), into out in the order of a
  * depth-first traversal whatever the thread count: the node pairs near the
  * top become tasks that OpenMP threads traverse into their own lists,
- * joined in task order. With only_dirty, node pairs where neither side is
+ * joined in task order. The boxes are those of the last cs_bvh_refit of
+ * each tree. With only_dirty, node pairs where neither side is
  * dirty are skipped; with rank >= 0 (after cs_bvh_set_ranks on both trees),
  * node pairs that cannot hold a pair going to rank. Returns 0 or -1 (no
  * memory). */
-int cs_bvh_collect(const cs_bvh *A, const cs_bvh *B, const cs_box *box_a, const cs_box *box_b,
-                   bool only_dirty, int rank, cs_bvh_work *w, cs_index_pairs *out);
+int cs_bvh_collect(const cs_bvh *A, const cs_bvh *B, bool only_dirty, int rank, cs_bvh_work *w,
+                   cs_index_pairs *out);
 
 static inline bool cs_box_overlap(const cs_box *a, const cs_box *b)
 {

@@ -264,27 +264,36 @@ typedef struct response {
  * if it interacted. Inelastic: I = m v_N stops approach; elastic: Eq. 1
  * with d from Eq. 2 (larger when the pair has crossed, so it pulls back);
  * friction: Coulomb with the normal velocity change. */
+/* Whether the boxes of a pair's two sides (vertices [0, split) and
+ * [split, 4) at positions p[k]) are more than gap apart along an axis:
+ * then the sides are farther apart than gap. */
+static bool sides_apart(const double *const p[4], int split, double gap)
+{
+    for (int d = 0; d < 3; d++) {
+        double lo_a = INFINITY, hi_a = -INFINITY, lo_b = INFINITY, hi_b = -INFINITY;
+        for (int k = 0; k < 4; k++) {
+            double c = p[k][d];
+            if (k < split) {
+                lo_a = c < lo_a ? c : lo_a;
+                hi_a = c > hi_a ? c : hi_a;
+            } else {
+                lo_b = c < lo_b ? c : lo_b;
+                hi_b = c > hi_b ? c : hi_b;
+            }
+        }
+        if (lo_a - hi_b > gap || lo_b - hi_a > gap)
+            return true;
+    }
+    return false;
+}
+
 /* The per-step prune of Section 5: step A keeps pairs generously, so most
  * are not interacting now; an h-thickened box test settles that cheaply. */
 static bool pair_near(const cs_pair *p, bool is_edge, const double *x, double h)
 {
-    int split = is_edge ? 2 : 3; /* first element: vertices [0, split) */
-    for (int d = 0; d < 3; d++) {
-        double lo_a = INFINITY, hi_a = -INFINITY, lo_b = INFINITY, hi_b = -INFINITY;
-        for (int k = 0; k < 4; k++) {
-            double c = x[3 * p->v[k] + d];
-            if (k < split) {
-                lo_a = fmin(lo_a, c);
-                hi_a = fmax(hi_a, c);
-            } else {
-                lo_b = fmin(lo_b, c);
-                hi_b = fmax(hi_b, c);
-            }
-        }
-        if (lo_a > hi_b + h || lo_b > hi_a + h)
-            return false;
-    }
-    return true;
+    const double *const pts[4] = {x + 3 * p->v[0], x + 3 * p->v[1], x + 3 * p->v[2],
+                                  x + 3 * p->v[3]};
+    return !sides_apart(pts, is_edge ? 2 : 3, h);
 }
 
 /* Bridson's proximity condition for a repulsion: a point/triangle pair
@@ -651,11 +660,10 @@ static bool make_repulsion_edge_edge(const void *ctx, int ea, int eb, cs_pair *o
 /* Traverses A against B and appends the pairs make accepts to list, in the
  * traversal's order at any thread count: threads make pairs from the
  * candidates in place, then they are kept in order. Returns 0 or -1. */
-static int find_pairs(cs_selfcol *sc, const cs_bvh *A, const cs_bvh *B, const cs_box *box_a,
-                      const cs_box *box_b, bool only_dirty, int rank, pair_maker make,
-                      const void *ctx, cs_pair_list *list)
+static int find_pairs(cs_selfcol *sc, const cs_bvh *A, const cs_bvh *B, bool only_dirty, int rank,
+                      pair_maker make, const void *ctx, cs_pair_list *list)
 {
-    if (cs_bvh_collect(A, B, box_a, box_b, only_dirty, rank, &sc->bvh_work, &sc->candidates))
+    if (cs_bvh_collect(A, B, only_dirty, rank, &sc->bvh_work, &sc->candidates))
         return -1;
     int n = sc->candidates.n;
     if (n > sc->made_capacity) {
@@ -729,10 +737,10 @@ void cs_selfcol_find_pairs(cs_sim *sim, double span)
     cs_bvh_refit(&sc->ttree, sc->tbox, NULL);
     finder f = {sim, sc, h, span};
     int rank = sim->par->rank;
-    int failed = find_pairs(sc, &sc->ptree, &sc->ttree, sc->pbox, sc->tbox, false, rank,
+    int failed = find_pairs(sc, &sc->ptree, &sc->ttree, false, rank,
                             make_repulsion_point_triangle, &f, &sc->pt) ||
-                 find_pairs(sc, &sc->etree, &sc->etree, sc->ebox, sc->ebox, false, rank,
-                            make_repulsion_edge_edge, &f, &sc->ee);
+                 find_pairs(sc, &sc->etree, &sc->etree, false, rank, make_repulsion_edge_edge,
+                            &f, &sc->ee);
     sc->stats.repulsion_pairs += sc->pt.n + sc->ee.n;
     if (distribute_boundary(sim, &sc->pt, &sc->ee) != 0)
         failed = 1;
@@ -790,28 +798,17 @@ static bool out_of_reach(const cs_selfcol *sc, bool is_edge, const double *x0, c
         for (int j = split; j < 4; j++) {
             double r[3];
             cs_sub(dx + 3 * j, dx + 3 * i, r);
-            reach2 = fmax(reach2, cs_dot(r, r));
+            double r2 = cs_dot(r, r);
+            reach2 = r2 > reach2 ? r2 : reach2;
         }
     for (int k = 0; k < 12; k++)
-        scale = fmax(scale, fabs(x0[k]) + fabs(dx[k]));
+        scale = fabs(x0[k]) + fabs(dx[k]) > scale ? fabs(x0[k]) + fabs(dx[k]) : scale;
     double need = sc->proximity + sqrt(reach2);
     need += 64 * DBL_EPSILON * (scale + need);
     /* a separating axis of the start boxes bounds the distance first */
-    for (int d = 0; d < 3; d++) {
-        double lo_a = INFINITY, hi_a = -INFINITY, lo_b = INFINITY, hi_b = -INFINITY;
-        for (int k = 0; k < 4; k++) {
-            double c = x0[3 * k + d];
-            if (k < split) {
-                lo_a = fmin(lo_a, c);
-                hi_a = fmax(hi_a, c);
-            } else {
-                lo_b = fmin(lo_b, c);
-                hi_b = fmax(hi_b, c);
-            }
-        }
-        if (lo_a - hi_b > need || lo_b - hi_a > need)
-            return true;
-    }
+    const double *const pts[4] = {x0, x0 + 3, x0 + 6, x0 + 9};
+    if (sides_apart(pts, split, need))
+        return true;
     double d0, w[3], s, t;
     if (is_edge)
         d0 = cs_segment_segment_closest(x0, x0 + 3, x0 + 6, x0 + 9, &s, &t);
@@ -998,10 +995,10 @@ static long find_collisions(cs_selfcol *sc, const cs_par *par, const double *x,
     cs_bvh_refit(&sc->ttree, sc->tbox, sc->tdirty);
     sc->cpt.n = sc->cee.n = 0;
     collector cl = {sc, par, x};
-    if (find_pairs(sc, &sc->ptree, &sc->ttree, sc->pbox, sc->tbox, only_dirty, par->rank,
+    if (find_pairs(sc, &sc->ptree, &sc->ttree, only_dirty, par->rank,
                    make_collision_point_triangle, &cl, &sc->cpt) ||
-        find_pairs(sc, &sc->etree, &sc->etree, sc->ebox, sc->ebox, only_dirty, par->rank,
-                   make_collision_edge_edge, &cl, &sc->cee))
+        find_pairs(sc, &sc->etree, &sc->etree, only_dirty, par->rank, make_collision_edge_edge,
+                   &cl, &sc->cee))
         return -1;
     return sc->cpt.n + sc->cee.n;
 }
