@@ -919,6 +919,19 @@ typedef struct collector {
     const double *x;
 } collector;
 
+/* The pair (v) this rank finds, if it collides, with its history. */
+static bool collision_of(const collector *cl, const int v[4], bool is_edge, cs_pair *out)
+{
+    if (pair_rank(cl->par, v) != cl->par->rank)
+        return false;
+    memcpy(out->v, v, sizeof out->v);
+    double c[4], nrm[3];
+    if (!pair_collides(cl->sc, out, is_edge, cl->x, c, nrm))
+        return false;
+    set_history(cl->sc, out, is_edge, nrm);
+    return true;
+}
+
 static bool make_collision_point_triangle(const void *ctx, int point, int t, cs_pair *out)
 {
     const collector *cl = ctx;
@@ -926,14 +939,7 @@ static bool make_collision_point_triangle(const void *ctx, int point, int t, cs_
     if (point == tri[0] || point == tri[1] || point == tri[2])
         return false; /* wings stay: a wing point crossing drags its other triangles through */
     int v[4] = {tri[0], tri[1], tri[2], point};
-    if (pair_rank(cl->par, v) != cl->par->rank)
-        return false;
-    memcpy(out->v, v, sizeof v);
-    double c[4], nrm[3];
-    if (!pair_collides(cl->sc, out, false, cl->x, c, nrm))
-        return false;
-    set_history(cl->sc, out, false, nrm);
-    return true;
+    return collision_of(cl, v, false, out);
 }
 
 static bool make_collision_edge_edge(const void *ctx, int ea, int eb, cs_pair *out)
@@ -943,14 +949,7 @@ static bool make_collision_edge_edge(const void *ctx, int ea, int eb, cs_pair *o
     if (a[0] == b[0] || a[0] == b[1] || a[1] == b[0] || a[1] == b[1])
         return false;
     int v[4] = {a[0], a[1], b[0], b[1]};
-    if (pair_rank(cl->par, v) != cl->par->rank)
-        return false;
-    memcpy(out->v, v, sizeof v);
-    double c[4], nrm[3];
-    if (!pair_collides(cl->sc, out, true, cl->x, c, nrm))
-        return false;
-    set_history(cl->sc, out, true, nrm);
-    return true;
+    return collision_of(cl, v, true, out);
 }
 
 /* Swept boxes from the free positions to x, and the pairs among their

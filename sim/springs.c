@@ -121,15 +121,17 @@ int cs_springs_add_mesh(cs_springs *s, int offset, int nv, int nt, const int *tr
     return 0;
 }
 
+static void free_rows(cs_springs *s)
+{
+    void *rows[] = {s->row_start, s->row_other, s->row_damping, s->row_direction,
+                    s->row_magnitude, s->row_stiffness, s->row_inv_rest_length};
+    for (size_t k = 0; k < sizeof rows / sizeof *rows; k++)
+        free(rows[k]);
+}
+
 int cs_springs_index(cs_springs *s, int nrows, const int *particles, int nparticles)
 {
-    free(s->row_start);
-    free(s->row_other);
-    free(s->row_damping);
-    free(s->row_direction);
-    free(s->row_magnitude);
-    free(s->row_stiffness);
-    free(s->row_inv_rest_length);
+    free_rows(s);
     s->nrows = nrows;
     s->row_damping = malloc(sizeof(double) * (2 * (size_t)s->n + 1));
     s->row_direction = malloc(sizeof(double) * 3 * (2 * (size_t)s->n + 1));
@@ -184,13 +186,7 @@ void cs_springs_free(cs_springs *s)
     free(s->inv_rest_length);
     free(s->stiffness);
     free(s->damping);
-    free(s->row_start);
-    free(s->row_other);
-    free(s->row_damping);
-    free(s->row_direction);
-    free(s->row_magnitude);
-    free(s->row_stiffness);
-    free(s->row_inv_rest_length);
+    free_rows(s);
     memset(s, 0, sizeof *s);
 }
 
