@@ -23,9 +23,6 @@
 
 struct cs_levelset {
     openvdb::FloatGrid::Ptr grid;
-    // The accessor caches the path to the last leaf, which makes the 64
-    // lookups of one query cheap; it is why a query is not thread-safe.
-    openvdb::FloatGrid::ConstUnsafeAccessor acc;
     double voxel;
     double background;
     bool filled;
@@ -35,7 +32,7 @@ struct cs_levelset {
     double inv_voxel, offset[3];
 
     explicit cs_levelset(openvdb::FloatGrid::Ptr g)
-        : grid(g), acc(g->getConstUnsafeAccessor()), voxel(g->voxelSize()[0]),
+        : grid(g), voxel(g->voxelSize()[0]),
           background(static_cast<double>(g->background())), filled(false), plain(false),
           inv_voxel(1.0 / voxel), offset{0, 0, 0}
     {
@@ -221,6 +218,10 @@ void cs_levelset_get_info(const cs_levelset *ls, cs_levelset_info *info)
 double cs_levelset_phi(const void *data, const double p[3], double grad[3])
 {
     const cs_levelset *ls = static_cast<const cs_levelset *>(data);
+    // An accessor of this query's own caches the path to the last leaf,
+    // which makes its 64 lookups cheap; one per query (unregistered, so
+    // cheap to make) keeps queries thread-safe: threads share the bodies.
+    openvdb::FloatGrid::ConstUnsafeAccessor acc = ls->grid->getConstUnsafeAccessor();
     openvdb::Vec3d q;
     if (ls->plain)
         for (int k = 0; k < 3; k++)
@@ -251,7 +252,7 @@ double cs_levelset_phi(const void *data, const double p[3], double grad[3])
         one_leaf = one_leaf && ((base[k] - 1) & ~7) == ((base[k] + 2) & ~7);
     const float *buf = nullptr;
     if (one_leaf) { // read the leaf's buffer, no tree walk per value
-        leaf = ls->acc.probeConstLeaf(openvdb::Coord(base[0] - 1, base[1] - 1, base[2] - 1));
+        leaf = acc.probeConstLeaf(openvdb::Coord(base[0] - 1, base[1] - 1, base[2] - 1));
         buf = leaf ? leaf->buffer().data() : nullptr;
     }
     for (int a = 0; a < 4; a++)
@@ -262,7 +263,7 @@ double cs_levelset_phi(const void *data, const double p[3], double grad[3])
                     continue;
                 int x = base[0] + a - 1, y = base[1] + b - 1, z = base[2] + d - 1;
                 v[a][b][d] = buf ? (double)buf[((x & 7) << 6) | ((y & 7) << 3) | (z & 7)]
-                                 : (double)ls->acc.getValue(openvdb::Coord(x, y, z));
+                                 : (double)acc.getValue(openvdb::Coord(x, y, z));
             }
     double phi = 0, g[3] = {0, 0, 0};
     for (int a = 1; a <= 2; a++)

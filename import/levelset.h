@@ -62,8 +62,9 @@ void cs_levelset_get_info(const cs_levelset *ls, cs_levelset_info *info);
 
 /* Trilinearly interpolated phi at p (in the grid's frame) and the unit
  * gradient, interpolated the same way from central differences at the
- * voxels; a cs_body_phi_fn for data = the cs_levelset. Not thread-safe:
- * each grid keeps an accessor cache. */
+ * voxels; a cs_body_phi_fn for data = the cs_levelset. Thread-safe (the
+ * simulation's threads query bodies side by side): each query makes its
+ * own accessor. */
 double cs_levelset_phi(const void *ls, const double p[3], double grad[3]);
 
 /* The library version, part of the cache key ("10.0.1"). */

@@ -109,7 +109,9 @@ typedef enum cs_body_shape {
 } cs_body_shape;
 
 /* A signed distance queried in the body's local frame: returns phi and writes
- * the unit gradient. Grid bodies (level sets from meshes) plug in here. */
+ * the unit gradient. Grid bodies (level sets from meshes) plug in here. It
+ * must be safe to call from several threads at once (the body stages visit
+ * points in parallel). */
 typedef double (*cs_body_phi_fn)(const void *data, const double p[3], double grad[3]);
 
 typedef struct cs_body_def {

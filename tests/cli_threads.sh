@@ -57,6 +57,16 @@ s = json.load(open(sys.argv[1]))
 assert sum(f["body_contacts"] for f in s["frames"]) > 0 and sum(f["cg_iterations"] for f in s["frames"]) > 0
 PY
 
+# a mesh body (an OpenVDB level set queried by both threads at once)
+for t in 1 2; do
+    run 0 run "$SCENES/bunny_drape.yaml" -o bunny$t --frames 8 --threads $t -q
+done
+same_frames bunny1 bunny2
+python3 - bunny1/summary.json <<'PY' || fail "the sheet never touched the bunny"
+import json, sys
+assert sum(f["body_contacts"] for f in json.load(open(sys.argv[1]))["frames"]) > 0
+PY
+
 # bad values are refused like other options
 run 1 run "$SCENES/drape.yaml" --threads 0 --plan
 err_has "--threads"
