@@ -112,6 +112,19 @@ static void usage_error(const char *fmt, const char *arg)
 enum { OPT_SET = 256, OPT_FORMAT, OPT_FRAMES, OPT_PLAN, OPT_RENDER, OPT_SIZE, OPT_SAMPLES,
        OPT_THREADS };
 
+/* Whether text is a whole number in [lo, hi] (stored in *out if given). */
+static bool whole_number(const char *text, long lo, long hi, int *out)
+{
+    char *end;
+    errno = 0;
+    long n = strtol(text, &end, 10);
+    if (end == text || *end || errno || n < lo || n > hi)
+        return false;
+    if (out)
+        *out = (int)n;
+    return true;
+}
+
 /* Returns -1 to go on, else an exit status. */
 static int parse_options(int argc, char **argv, run_options *o)
 {
@@ -164,28 +177,19 @@ static int parse_options(int argc, char **argv, run_options *o)
             }
             o->format = optarg;
             break;
-        case OPT_FRAMES: {
-            char *end;
-            errno = 0;
-            long n = strtol(optarg, &end, 10);
-            if (end == optarg || *end || errno || n < 0 || n > 100000000) {
+        case OPT_FRAMES:
+            if (!whole_number(optarg, 0, 100000000, NULL)) {
                 usage_error("--frames: '%s' is not a whole number of frames", optarg);
                 return CS_EXIT_USAGE;
             }
             frames = optarg;
             break;
-        }
-        case OPT_THREADS: {
-            char *end;
-            errno = 0;
-            long n = strtol(optarg, &end, 10);
-            if (end == optarg || *end || errno || n < 1 || n > 4096) {
+        case OPT_THREADS:
+            if (!whole_number(optarg, 1, 4096, &o->threads)) {
                 usage_error("--threads: '%s' is not a whole number from 1 to 4096", optarg);
                 return CS_EXIT_USAGE;
             }
-            o->threads = (int)n;
             break;
-        }
         case OPT_PLAN:
             o->plan_only = true;
             break;

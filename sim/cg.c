@@ -51,6 +51,20 @@ static inline void precondition(const double inv[6], const double r[3], double o
     out[2] = inv[4] * r[0] + inv[5] * r[1] + inv[2] * r[2];
 }
 
+/* y_i = P B_i^-1 r_i, adding r_i . y_i to *sum and raising *worst to the
+ * residual in velocity units |r_i| / m_i */
+static inline void precondition_row(const cs_sim *sim, int i, const double *ri, double *yi,
+                                    double *sum, double *worst)
+{
+    precondition(sim->cg.block + 6 * i, ri, yi);
+    project_row(sim, i, yi);
+    for (int d = 0; d < 3; d++)
+        *sum += ri[d] * yi[d];
+    double res = cs_norm(ri) / sim->mass[i];
+    if (res > *worst)
+        *worst = res;
+}
+
 void cs_damping_apply(const cs_sim *sim, const double *v, double *out)
 {
     const int *own = cs_par_owned(sim->par);
@@ -183,7 +197,7 @@ int cs_cg_solve(cs_sim *sim, double *v0, const double *rhs, double *v, double *w
         }
     }
     cs_halo_forward(par, &par->ghosts, w->y, 3);
-    /* r = P (rhs - A y), p = P diag^-1 r (y is read across particles here,
+    /* r = P (rhs - A y), p = P B^-1 r (y is read across particles here,
      * so the preconditioned residual goes straight into p) */
     FOR_BLOCKS(sim, b, r0, r1) {
         double sum = 0, worst = 0;
@@ -194,11 +208,7 @@ int cs_cg_solve(cs_sim *sim, double *v0, const double *rhs, double *v, double *w
             for (int d = 0; d < 3; d++)
                 ri[d] = rhs[3 * i + d] - q[d];
             project_row(sim, i, ri);
-            precondition(w->block + 6 * i, ri, pi);
-            project_row(sim, i, pi);
-            for (int d = 0; d < 3; d++)
-                sum += ri[d] * pi[d];
-            worst = fmax(worst, cs_norm(ri) / sim->mass[i]);
+            precondition_row(sim, i, ri, pi, &sum, &worst);
         }
         part_sum[b] = sum;
         part_max[b] = worst;
@@ -234,11 +244,7 @@ int cs_cg_solve(cs_sim *sim, double *v0, const double *rhs, double *v, double *w
                     w->z[k] += alpha * w->p[k];
                     w->r[k] -= alpha * w->q[k];
                 }
-                precondition(w->block + 6 * i, ri, yi);
-                project_row(sim, i, yi);
-                for (int d = 0; d < 3; d++)
-                    sum += ri[d] * yi[d];
-                worst = fmax(worst, cs_norm(ri) / sim->mass[i]);
+                precondition_row(sim, i, ri, yi, &sum, &worst);
             }
             part_sum[b] = sum;
             part_max[b] = worst;

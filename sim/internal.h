@@ -30,7 +30,7 @@ typedef struct cs_cloth_state {
 enum { CS_BLOCK = 1024 };
 
 typedef struct cs_cg_work {
-    double *z, *r, *y, *p, *q, *diag, *b;
+    double *z, *r, *y, *p, *q, *b;
     double *explicit_z;          /* the explicit update CG starts from */
     double *block;               /* 6 per particle: the preconditioner's 3 x 3 inverse */
     double *warm_half, *warm_full; /* last damping responses of B.1 and B.5 */

@@ -1100,7 +1100,8 @@ static void rigidify_zones(cs_sim *sim, double span, double *dv)
 {
     cs_selfcol *sc = sim->selfcol;
     int n = sc->n;
-    double *u = sim->v_half, *mw = sim->cg.diag; /* scratch: free during step C */
+    /* scratch, free during step C: v_half, and CG's explicit start */
+    double *u = sim->v_half, *mw = sim->cg.explicit_z;
     double heaviest = 0;
     for (int i = 0; i < n; i++)
         heaviest = fmax(heaviest, sim->mass[i]);

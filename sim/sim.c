@@ -212,7 +212,7 @@ cs_sim *cs_sim_create(const cs_sim_def *def, char *err, size_t errlen)
     sim->v0 = alloc3(n);
     sim->rhs = alloc3(n);
     double **cg[] = {&sim->cg.z, &sim->cg.r, &sim->cg.y, &sim->cg.p, &sim->cg.q,
-                     &sim->cg.diag, &sim->cg.b, &sim->cg.explicit_z, &sim->cg.warm_half,
+                     &sim->cg.b, &sim->cg.explicit_z, &sim->cg.warm_half,
                      &sim->cg.warm_full};
     bool ok = sim->x && sim->v && sim->mass && sim->is_free && sim->mode && sim->cloths &&
               sim->x_prev && sim->v_half && sim->v_star && sim->v_next && sim->force &&
@@ -401,7 +401,7 @@ void cs_sim_destroy(cs_sim *sim)
     double *arrays[] = {sim->x, sim->v, sim->mass, sim->x_prev, sim->v_half, sim->v_star,
                         sim->v_next, sim->force, sim->v0, sim->rhs, sim->script_x,
                         sim->script_v, sim->contact_normal, sim->wind_normal, sim->wind_area, sim->v_rewind,
-                        sim->cg.z, sim->cg.r, sim->cg.y, sim->cg.p, sim->cg.q, sim->cg.diag,
+                        sim->cg.z, sim->cg.r, sim->cg.y, sim->cg.p, sim->cg.q,
                         sim->cg.b, sim->cg.partial, sim->cg.explicit_z, sim->cg.warm_half,
                         sim->cg.warm_full, sim->cg.block};
     for (size_t k = 0; k < sizeof arrays / sizeof *arrays; k++)

@@ -247,19 +247,6 @@ void cs_springs_add_damping(const cs_springs *s, const double *v, double *out)
     }
 }
 
-void cs_springs_add_damping_diagonal(const cs_springs *s, double *diag)
-{
-#pragma omp parallel for schedule(static)
-    for (int r = 0; r < s->nrows; r++) {
-        int i = s->row_particle[r];
-        for (int e = s->row_start[r]; e < s->row_start[r + 1]; e++) {
-            const double *u = s->row_direction + 3 * e;
-            for (int d = 0; d < 3; d++)
-                diag[3 * i + d] += s->row_damping[e] * u[d] * u[d];
-        }
-    }
-}
-
 double cs_springs_stiffness_bound(const cs_springs *s, const double *mass,
                                   const unsigned char *is_free, int nparticles)
 {

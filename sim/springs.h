@@ -78,8 +78,6 @@ void cs_springs_add_elastic(cs_springs *s, const double *x, double *f);
 /* out += D v, the damping force (D is the velocity Jacobian, symmetric
  * negative semi-definite), with the directions from cs_springs_prepare. */
 void cs_springs_add_damping(const cs_springs *s, const double *v, double *out);
-/* diag += -diag(D) per coordinate, for the Jacobi preconditioner. */
-void cs_springs_add_damping_diagonal(const cs_springs *s, double *diag);
 /* Keeps only the springs with an end owned by rank (Section 7: a spring
  * across ranks is computed by both owners, redundantly). */
 void cs_springs_keep_touching(cs_springs *s, const int *owner, int rank);
