@@ -156,6 +156,8 @@ int cs_levelset_main(int argc, char **argv)
         fprintf(stderr, "clothsim levelset: %s\n", err);
         return rc == CS_IMPORT_NOMEM ? CS_EXIT_OUTPUT : CS_EXIT_INPUT;
     }
+    if (rep.size_warning[0])
+        fprintf(stderr, "clothsim levelset: warning: %s: %s\n", path, rep.size_warning);
     printf("mesh:      %s: %d triangles, %d vertices, %s", path, rep.triangles, rep.vertices,
            rep.closed ? "closed\n" : "open");
     if (!rep.closed) {

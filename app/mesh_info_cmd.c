@@ -26,8 +26,12 @@ void cs_mesh_info_help(FILE *out)
           "      --scale S     a uniform scale after the units\n"
           "  -h, --help        show this help\n"
           "\n"
-          "exit status: 0 read; 1 bad command line; 2 the file cannot be read or holds\n"
-          "no usable triangles.\n",
+          "A file is read in a separate process with limits, so that no file can crash or\n"
+          "hang the command: CLOTHSIM_IMPORT_SECONDS (CPU seconds, default 30 + 1 per MB)\n"
+          "and CLOTHSIM_IMPORT_MEMORY (MB, default 1024 + 64 per MB of file) raise them.\n"
+          "\n"
+          "exit status: 0 read; 1 bad command line; 2 the file cannot be read, is corrupt\n"
+          "or holds no usable triangles.\n",
           out);
 }
 
@@ -177,6 +181,10 @@ int cs_mesh_info_main(int argc, char **argv)
         return rc == CS_IMPORT_NOMEM ? CS_EXIT_OUTPUT : CS_EXIT_INPUT;
     }
     print_report(&place, &rep);
+    if (rep.size_warning[0]) {
+        fflush(stdout);
+        fprintf(stderr, "clothsim mesh-info: warning: %s: %s\n", path, rep.size_warning);
+    }
     cs_trimesh_destroy(mesh);
     return CS_EXIT_OK;
 }

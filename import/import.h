@@ -46,12 +46,18 @@ typedef struct cs_mesh_view {
 
 /* Writes the meshes as one file through assimp's exporter. The file appears
  * atomically (written beside it, then renamed), so a frame on disk is always
- * complete. Returns CS_IMPORT_OK or CS_IMPORT_BAD_INPUT with err filled. */
+ * complete. A mesh with vertices and no triangles (nt 0) is written as
+ * points: PLY vertices only, OBJ "p" lines, glTF POINTS. Returns
+ * CS_IMPORT_OK or CS_IMPORT_BAD_INPUT with err filled. */
 int cs_mesh_write(const char *path, cs_mesh_format format, int nmeshes,
                   const cs_mesh_view *meshes, char *err, size_t errlen);
 
-/* Reads every mesh of a file through assimp (triangulated, identical
- * vertices joined) merged into one cs_trimesh. NULL with err on failure. */
+/* Reads every mesh of a file through assimp (triangulated; vertices of
+ * OBJ, STL and other formats that list them per corner joined; PLY and
+ * glTF numbered as written) merged into one cs_trimesh, as
+ * cs_mesh_import does it (in a child process). Meshes without triangles
+ * give their vertices: a frame of a cloth without triangles is a point
+ * cloud (nt 0). NULL with err on failure. */
 cs_trimesh *cs_mesh_read(const char *path, char *err, size_t errlen);
 
 /* --------------------------------------------------------- mesh import */
@@ -98,6 +104,9 @@ typedef struct cs_mesh_report {
     double min[3], max[3];       /* bounds of the result, m */
     double area;                 /* m^2 */
     double volume;               /* m^3 enclosed, from the divergence theorem */
+    char size_warning[320];      /* "" or why the size looks like wrong units
+                                    (a format without units, e.g. an STL in
+                                    millimetres read as metres) */
 } cs_mesh_report;
 
 /* Reads a mesh file through assimp (OBJ, PLY, STL, glTF 2.0, FBX, Collada
@@ -106,8 +115,12 @@ typedef struct cs_mesh_report {
  * positions and drops zero-area and duplicate triangles and unreferenced
  * vertices, counting each in the report (which may be NULL). A missing,
  * unreadable or corrupt file, a node that is not there, a non-finite
- * coordinate or a result without triangles is CS_IMPORT_BAD_INPUT with a
- * sentence in err. */
+ * coordinate, a result without triangles or one whose triangles use less
+ * than half of the vertices (most of the file not understood) is
+ * CS_IMPORT_BAD_INPUT with a sentence in err. The file is read in a child
+ * process with limits on time and memory, so that no file can crash or
+ * hang the caller (limits: CLOTHSIM_IMPORT_SECONDS of CPU, default 30 + 1
+ * per MB of file; CLOTHSIM_IMPORT_MEMORY MB, default 1024 + 64 per MB). */
 int cs_mesh_import(const char *path, const cs_mesh_placement *place, cs_trimesh **out,
                    cs_mesh_report *report, char *err, size_t errlen);
 
@@ -196,8 +209,13 @@ double cs_levelset_estimate_voxels(const cs_mesh_report *mesh, double voxel, dou
                                    bool fill_interior);
 double cs_levelset_estimate_bytes(const cs_mesh_report *mesh, double voxel, double band,
                                   bool fill_interior);
-/* Memory available now (MemAvailable), bytes; 0 if unknown. */
+/* memory.c: memory available now (MemAvailable), bytes; 0 if unknown. */
 double cs_memory_available(void);
+/* "310 GB", "2.5 MB": three significant digits. */
+void cs_format_bytes(double bytes, char *buf, size_t len);
+/* True when need bytes fit in three quarters of what is available; else
+ * false with "would need about X of memory, but Y is available" in why. */
+bool cs_memory_fits(double need, char *why, size_t len);
 
 /* True when the voxel size suits the mesh: at most a quarter of its largest
  * extent, and the estimated memory within what is available. Else false,

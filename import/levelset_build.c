@@ -61,38 +61,12 @@ double cs_levelset_estimate_bytes(const cs_mesh_report *m, double voxel, double 
            fill_voxels(m, voxel, fill) * FILL_PEAK_BYTES;
 }
 
-double cs_memory_available(void)
-{
-    FILE *f = fopen("/proc/meminfo", "r");
-    char line[256];
-    double kb = 0;
-    if (!f)
-        return 0;
-    while (fgets(line, sizeof line, f))
-        if (sscanf(line, "MemAvailable: %lf kB", &kb) == 1)
-            break;
-    fclose(f);
-    return kb * 1024.0;
-}
-
 static double largest_extent(const cs_mesh_report *m)
 {
     double e = 0;
     for (int k = 0; k < 3; k++)
         e = fmax(e, m->max[k] - m->min[k]);
     return e;
-}
-
-static void human_bytes(double b, char *buf, size_t len)
-{
-    if (b >= 1e12)
-        snprintf(buf, len, "%.3g TB", b / 1e12);
-    else if (b >= 1e9)
-        snprintf(buf, len, "%.3g GB", b / 1e9);
-    else if (b >= 1e6)
-        snprintf(buf, len, "%.3g MB", b / 1e6);
-    else
-        snprintf(buf, len, "%.3g kB", b / 1e3);
 }
 
 bool cs_levelset_voxel_ok(const cs_mesh_report *m, double voxel, double band, bool fill,
@@ -111,17 +85,14 @@ bool cs_levelset_voxel_ok(const cs_mesh_report *m, double voxel, double band, bo
         return false;
     }
     double need = cs_levelset_estimate_bytes(m, voxel, band, fill);
-    double have = cs_memory_available();
-    /* int32 voxel coordinates, and a sanity bound when /proc says nothing */
-    bool too_many = ext / voxel > 1e8 || (have <= 0 && need > 64e9);
-    if (too_many || (have > 0 && need > 0.75 * have)) {
-        char n[32], h[32];
-        human_bytes(need, n, sizeof n);
-        human_bytes(have, h, sizeof h);
-        snprintf(why, len,
-                 "would need about %s of memory for %.3g voxels at this size, but %s is "
-                 "available; use a larger voxel size",
-                 n, cs_levelset_estimate_voxels(m, voxel, band, fill), have > 0 ? h : "unknown");
+    char fits[160];
+    /* int32 voxel coordinates bound the grid whatever the memory */
+    if (ext / voxel > 1e8 || !cs_memory_fits(need, fits, sizeof fits)) {
+        snprintf(why, len, "%s (%.3g voxels at this size); use a larger voxel size",
+                 ext / voxel > 1e8 ? "would need about 1e8 voxels along an axis, more "
+                                     "than int32 coordinates hold"
+                                   : fits,
+                 cs_levelset_estimate_voxels(m, voxel, band, fill));
         return false;
     }
     return true;

@@ -5,13 +5,26 @@
  * with its transforms (only the selected nodes or meshes), coordinates are
  * checked for NaN before anything could hide them (assimp's own vertex
  * joining merges all NaN vertices into one), units and the placement are
- * applied, vertices at identical positions are joined (STL and unwelded PLY
- * store one per triangle corner, and glTF splits at UV seams), and
- * zero-area and duplicate triangles are dropped. The topology is then
- * analysed: boundary, non-manifold and inconsistently oriented edges,
- * parts, closedness.
+ * applied, and the mesh is repaired and analysed (mesh_repair.c).
+ *
+ * A mesh file must never crash or hang the command that reads it (issue
+ * 12). So each of the three readers below (cs_mesh_read, cs_mesh_import,
+ * cs_mesh_catalog_read) does its work in a child process with limits
+ * (mesh_guard.c) and sends back plain numbers; in that child the file is
+ * checked before assimp sees it (mesh_check.c), assimp reads it without
+ * post-processing, its faces are checked, and only then does assimp
+ * triangulate.
+ *
+ * What that costs, measured on a 2-core machine shared with other work
+ * (load about 4, so roughly), Release build, each a fresh process as a
+ * command is, median of 7 runs interleaved with the code before issue 12:
+ * cs_mesh_import of assets/stanford-bunny.obj (2.4 MB) 438 ms before, 491
+ * ms after, 464 ms with CLOTHSIM_IMPORT_ISOLATION=0; CPU time 327, 351 and
+ * 326 ms: the checks cost next to nothing, the child about 25 ms of CPU.
+ * The bunny as a binary PLY frame through cs_mesh_read: CPU time 202 ms
+ * before, 120 ms after (PLY is no longer joined, see cs_mesh_read).
  */
-#include "import/import.h"
+#include "import/mesh_internal.h"
 
 #include <assimp/cimport.h>
 #include <assimp/postprocess.h>
@@ -19,7 +32,6 @@
 
 #include <errno.h>
 #include <math.h>
-#include <stdarg.h>
 #include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -27,15 +39,7 @@
 #include <strings.h>
 #include <unistd.h>
 
-static void set_err(char *err, size_t errlen, const char *fmt, ...)
-{
-    if (!err || errlen == 0)
-        return;
-    va_list ap;
-    va_start(ap, fmt);
-    vsnprintf(err, errlen, fmt, ap);
-    va_end(ap);
-}
+#define set_err cs_mesh_set_err
 
 cs_mesh_placement cs_default_mesh_placement(void)
 {
@@ -64,18 +68,23 @@ bool cs_mesh_units_from_name(const char *name, double *metres)
 
 /* ----------------------------------------------------------- opening */
 
-/* Opens with assimp; on failure says why, the system's reason first
- * (assimp only says "Unable to open file"). */
-static const struct aiScene *open_scene(const char *path, unsigned flags, char *err,
-                                        size_t errlen)
+/* Opens with assimp (in the guard's child); on failure says why, the
+ * system's reason first (assimp only says "Unable to open file"). The
+ * file is pre-checked, read without post-processing, its faces checked,
+ * and then post-processed with flags; join_unindexed adds the joining of
+ * identical vertices for formats that list them per corner (not PLY or
+ * glTF, which keep the writer's numbering). */
+static int open_scene(const char *path, unsigned flags, bool join_unindexed,
+                      const struct aiScene **out, char *err, size_t errlen)
 {
+    *out = NULL;
     if (!path || !*path) {
         set_err(err, errlen, "no mesh file given");
-        return NULL;
+        return CS_IMPORT_BAD_INPUT;
     }
     if (access(path, R_OK) != 0) {
         set_err(err, errlen, "cannot read %s: %s", path, strerror(errno));
-        return NULL;
+        return CS_IMPORT_BAD_INPUT;
     }
     FILE *f = fopen(path, "rb");
     if (!f || fgetc(f) == EOF) {
@@ -84,22 +93,43 @@ static const struct aiScene *open_scene(const char *path, unsigned flags, char *
         if (f)
             fclose(f);
         set_err(err, errlen, "cannot read %s: %s", path, e ? strerror(e) : "the file is empty");
-        return NULL;
+        return CS_IMPORT_BAD_INPUT;
     }
     fclose(f);
-    const struct aiScene *scene = aiImportFile(path, flags);
+    cs_mesh_precheck_result pc;
+    int rc = cs_mesh_precheck(path, &pc, err, errlen);
+    if (rc != CS_IMPORT_OK)
+        return rc;
+    /* no post-processing yet: it trusts face indices nothing has checked */
+    const struct aiScene *scene =
+        pc.data ? aiImportFileFromMemory((const char *)pc.data, (unsigned)pc.len, 0, pc.hint)
+                : aiImportFile(path, 0);
+    free(pc.data);
     if (!scene) {
         const char *why = aiGetErrorString();
         set_err(err, errlen, "cannot read %s: %s", path,
                 why && *why ? why : "assimp could not import it");
-        return NULL;
+        return why && strstr(why, "bad_alloc") ? CS_IMPORT_NOMEM : CS_IMPORT_BAD_INPUT;
+    }
+    if ((rc = cs_mesh_check_scene(scene, path, err, errlen)) != CS_IMPORT_OK) {
+        aiReleaseImport(scene);
+        return rc;
+    }
+    if (join_unindexed && pc.kind != CS_KIND_PLY && pc.kind != CS_KIND_GLTF)
+        flags |= aiProcess_JoinIdenticalVertices;
+    if (flags && !(scene = aiApplyPostProcessing(scene, flags))) {
+        const char *why = aiGetErrorString();   /* the scene is released */
+        set_err(err, errlen, "cannot read %s: %s", path,
+                why && *why ? why : "assimp's post-processing failed");
+        return CS_IMPORT_BAD_INPUT;
     }
     if (!scene->mRootNode) {
         set_err(err, errlen, "cannot read %s: the file has no scene nodes", path);
         aiReleaseImport(scene);
-        return NULL;
+        return CS_IMPORT_BAD_INPUT;
     }
-    return scene;
+    *out = scene;
+    return CS_IMPORT_OK;
 }
 
 static void format_name(const struct aiScene *scene, const char *path, char *out, size_t len)
@@ -117,10 +147,12 @@ static void format_name(const struct aiScene *scene, const char *path, char *out
 /* Metres per file unit as the file declares it. Only FBX says so in a form
  * assimp passes on (UnitScaleFactor, centimetres per unit); Collada's
  * <unit meter> is applied by assimp itself; glTF is metres by definition;
- * OBJ, PLY and STL carry no unit and are taken as metres. */
-static double file_units(const struct aiScene *scene, const char *format, char *why, size_t len)
+ * OBJ, PLY and STL carry no unit and are taken as metres (*unitless). */
+static double file_units(const struct aiScene *scene, const char *format, char *why, size_t len,
+                         bool *unitless)
 {
     const struct aiMetadata *md = scene->mMetaData;
+    *unitless = false;
     for (unsigned i = 0; md && i < md->mNumProperties; i++) {
         if (strcmp(md->mKeys[i].data, "UnitScaleFactor") != 0)
             continue;
@@ -138,8 +170,10 @@ static double file_units(const struct aiScene *scene, const char *format, char *
         snprintf(why, len, "metres (glTF is in metres by definition)");
     else if (strstr(format, "Collada"))
         snprintf(why, len, "metres (the file's <unit> applied by assimp)");
-    else
+    else {
         snprintf(why, len, "metres (the format has no units; set units to change)");
+        *unitless = true;
+    }
     return 1.0;
 }
 
@@ -154,6 +188,8 @@ typedef struct walk_state {
     int nodes;               /* visited, for the report */
     int bad_vertex;          /* first non-finite vertex, else -1 */
     bool too_deep;
+    bool keep_points;        /* take the vertices of meshes of points
+                                only, or of no faces (point clouds) */
 } walk_state;
 
 static void mat_mul(const double a[16], const double b[16], double c[16])
@@ -176,7 +212,7 @@ static void mat_from_ai(const struct aiMatrix4x4 *m, double out[16])
 
 static void add_mesh(walk_state *st, const struct aiMesh *mesh, const double world[16])
 {
-    long base = st->nv, ntri = 0;
+    long base = st->nv, ntri = 0, npoints = 0;
     if (!mesh->mVertices || mesh->mNumVertices == 0) {
         st->skipped += mesh->mNumFaces;
         return;
@@ -184,6 +220,7 @@ static void add_mesh(walk_state *st, const struct aiMesh *mesh, const double wor
     for (unsigned f = 0; f < mesh->mNumFaces; f++) {
         const struct aiFace *face = &mesh->mFaces[f];
         if (face->mNumIndices != 3) {
+            npoints += face->mNumIndices == 1;
             st->skipped++;
             continue;
         }
@@ -199,8 +236,9 @@ static void add_mesh(walk_state *st, const struct aiMesh *mesh, const double wor
                 st->tri[3 * (st->nt + ntri) + k] = (int)(base + face->mIndices[k]);
         ntri++;
     }
-    if (ntri == 0)
-        return;   /* points and lines carry no surface */
+    /* points and lines carry no surface; a point cloud is a frame */
+    if (ntri == 0 && !(st->keep_points && npoints == (long)mesh->mNumFaces))
+        return;
     st->instances++;
     if (st->x) {
         for (unsigned v = 0; v < mesh->mNumVertices; v++) {
@@ -263,489 +301,6 @@ static void list_names(const struct aiNode *node, char *buf, size_t len, int *co
         list_names(node->mChildren[c], buf, len, count, depth + 1);
 }
 
-/* ---------------------------------------------------------- welding */
-
-static uint64_t mix64(uint64_t h)
-{
-    h ^= h >> 33;
-    h *= 0xff51afd7ed558ccdULL;
-    h ^= h >> 33;
-    h *= 0xc4ceb9fe1a85ec53ULL;
-    h ^= h >> 33;
-    return h;
-}
-
-static uint64_t hash_point(const double *p)
-{
-    uint64_t h = 0x9e3779b97f4a7c15ULL;
-    for (int k = 0; k < 3; k++) {
-        double v = p[k] + 0.0; /* -0.0 and 0.0 are one position */
-        uint64_t bits;
-        memcpy(&bits, &v, sizeof bits);
-        h = mix64(h ^ bits) + (uint64_t)k;
-    }
-    return h;
-}
-
-/* Joins vertices at exactly equal positions: remap[i] is the kept index,
- * kept vertices renumbered from 0 in first-seen order. Returns the count
- * kept, or -1 when memory runs out. */
-static int weld(const double *x, int nv, int *remap)
-{
-    size_t cap = 16;
-    while (cap < 2 * (size_t)nv)
-        cap *= 2;
-    int *table = malloc(cap * sizeof *table);   /* original index of a kept vertex */
-    int *first = malloc((size_t)nv * sizeof *first);
-    if (!table || !first) {
-        free(table);
-        free(first);
-        return -1;
-    }
-    for (size_t i = 0; i < cap; i++)
-        table[i] = -1;
-    int kept = 0;
-    for (int i = 0; i < nv; i++) {
-        const double *p = x + 3 * i;
-        size_t h = (size_t)hash_point(p) & (cap - 1);
-        for (;;) {
-            int j = table[h];
-            if (j < 0) {
-                table[h] = i;
-                first[i] = kept;
-                remap[i] = kept++;
-                break;
-            }
-            const double *q = x + 3 * j;
-            if (p[0] == q[0] && p[1] == q[1] && p[2] == q[2]) {
-                remap[i] = first[j];
-                break;
-            }
-            h = (h + 1) & (cap - 1);
-        }
-    }
-    free(table);
-    free(first);
-    return kept;
-}
-
-/* ------------------------------------------------------ clean-up */
-
-static double tri_area2(const double *x, const int *t, double cr[3])
-{
-    const double *a = x + 3 * t[0], *b = x + 3 * t[1], *c = x + 3 * t[2];
-    double u[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]};
-    double w[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};
-    cr[0] = u[1] * w[2] - u[2] * w[1];
-    cr[1] = u[2] * w[0] - u[0] * w[2];
-    cr[2] = u[0] * w[1] - u[1] * w[0];
-    return sqrt(cr[0] * cr[0] + cr[1] * cr[1] + cr[2] * cr[2]);
-}
-
-typedef struct tri_key {
-    int v[3];   /* sorted */
-    int index;
-} tri_key;
-
-static int tri_key_cmp(const void *pa, const void *pb)
-{
-    const tri_key *a = pa, *b = pb;
-    for (int k = 0; k < 3; k++)
-        if (a->v[k] != b->v[k])
-            return a->v[k] < b->v[k] ? -1 : 1;
-    return (a->index > b->index) - (a->index < b->index);
-}
-
-static void sort3(int v[3])
-{
-    int t;
-    if (v[0] > v[1])
-        t = v[0], v[0] = v[1], v[1] = t;
-    if (v[1] > v[2])
-        t = v[1], v[1] = v[2], v[2] = t;
-    if (v[0] > v[1])
-        t = v[0], v[0] = v[1], v[1] = t;
-}
-
-/* Welds, drops zero-area and duplicate triangles and unreferenced vertices.
- * x/tri are the raw arrays (nv, nt); returns a new mesh or NULL (memory). */
-static cs_trimesh *clean(const double *x, int nv, const int *tri, int nt, cs_mesh_report *r)
-{
-    int *remap = malloc(((size_t)nv + 1) * sizeof *remap);
-    int *t2 = malloc(((size_t)nt * 3 + 1) * sizeof *t2);
-    tri_key *keys = malloc(((size_t)nt + 1) * sizeof *keys);
-    unsigned char *drop = calloc((size_t)nt + 1, 1);
-    int *used = NULL;
-    cs_trimesh *out = NULL;
-    if (!remap || !t2 || !keys || !drop)
-        goto done;
-    int kept = weld(x, nv, remap);
-    if (kept < 0)
-        goto done;
-    r->welded_vertices = nv - kept;
-
-    /* zero area, relative to the mesh's size so that units do not matter */
-    double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
-    for (int i = 0; i < nv; i++)
-        for (int k = 0; k < 3; k++) {
-            lo[k] = fmin(lo[k], x[3 * i + k]);
-            hi[k] = fmax(hi[k], x[3 * i + k]);
-        }
-    double diag2 = 0;
-    for (int k = 0; k < 3; k++)
-        diag2 += (hi[k] - lo[k]) * (hi[k] - lo[k]);
-    int nk = 0;
-    for (int t = 0; t < nt; t++) {
-        int v[3];
-        double cr[3];
-        for (int k = 0; k < 3; k++)
-            v[k] = t2[3 * t + k] = remap[tri[3 * t + k]];
-        if (v[0] == v[1] || v[1] == v[2] || v[0] == v[2] ||
-            !(tri_area2(x, tri + 3 * t, cr) > 1e-14 * diag2)) {
-            drop[t] = 1;
-            r->degenerate_triangles++;
-            continue;
-        }
-        sort3(v);
-        memcpy(keys[nk].v, v, sizeof v);
-        keys[nk++].index = t;
-    }
-    /* duplicates, either orientation: the first in file order stays */
-    qsort(keys, (size_t)nk, sizeof *keys, tri_key_cmp);
-    for (int i = 1; i < nk; i++)
-        if (!memcmp(keys[i].v, keys[i - 1].v, sizeof keys[i].v)) {
-            drop[keys[i].index] = 1;
-            r->duplicate_triangles++;
-        }
-
-    /* keep referenced vertices, in order */
-    used = malloc(((size_t)kept + 1) * sizeof *used);
-    if (!used)
-        goto done;
-    for (int i = 0; i < kept; i++)
-        used[i] = -1;
-    int ntri = 0, nvert = 0;
-    for (int t = 0; t < nt; t++) {
-        if (drop[t])
-            continue;
-        ntri++;
-        for (int k = 0; k < 3; k++)
-            if (used[t2[3 * t + k]] < 0)
-                used[t2[3 * t + k]] = nvert++;
-    }
-    r->unreferenced_vertices = kept - nvert;
-    out = cs_trimesh_create(nvert, ntri);
-    if (!out)
-        goto done;
-    for (int i = 0; i < nv; i++) {
-        int j = used[remap[i]];
-        if (j >= 0)
-            memcpy(out->x + 3 * j, x + 3 * i, 3 * sizeof(double));
-    }
-    int o = 0;
-    for (int t = 0; t < nt; t++) {
-        if (drop[t])
-            continue;
-        for (int k = 0; k < 3; k++)
-            out->tri[3 * o + k] = used[t2[3 * t + k]];
-        o++;
-    }
-done:
-    free(remap);
-    free(t2);
-    free(keys);
-    free(drop);
-    free(used);
-    return out;
-}
-
-/* ---------------------------------------------------------- topology */
-
-typedef struct half_edge {
-    int a, b;   /* a < b */
-    int dir;    /* +1: a -> b in its triangle, -1: b -> a */
-    int tri;
-} half_edge;
-
-static int half_edge_cmp(const void *pa, const void *pb)
-{
-    const half_edge *p = pa, *q = pb;
-    if (p->a != q->a)
-        return p->a < q->a ? -1 : 1;
-    if (p->b != q->b)
-        return p->b < q->b ? -1 : 1;
-    return (p->tri > q->tri) - (p->tri < q->tri);
-}
-
-static int find_root(int *parent, int i)
-{
-    while (parent[i] != i) {
-        parent[i] = parent[parent[i]];
-        i = parent[i];
-    }
-    return i;
-}
-
-/* Boundary half-edges (as the triangle walks them: from -> to). */
-typedef struct bedge {
-    int from, to;
-} bedge;
-
-static int bedge_cmp(const void *pa, const void *pb)
-{
-    const bedge *p = pa, *q = pb;
-    if (p->from != q->from)
-        return p->from < q->from ? -1 : 1;
-    return (p->to > q->to) - (p->to < q->to);
-}
-
-/* The boundary half-edges sorted by start vertex; count in *n. */
-static bedge *boundary_edges(const cs_trimesh *m, int *n)
-{
-    size_t ne = 3 * (size_t)m->nt;
-    half_edge *e = malloc((ne + 1) * sizeof *e);
-    bedge *b = malloc((ne + 1) * sizeof *b);
-    *n = 0;
-    if (!e || !b) {
-        free(e);
-        free(b);
-        return NULL;
-    }
-    for (int t = 0; t < m->nt; t++)
-        for (int k = 0; k < 3; k++) {
-            int u = m->tri[3 * t + k], v = m->tri[3 * t + (k + 1) % 3];
-            half_edge *h = &e[3 * t + k];
-            h->a = u < v ? u : v;
-            h->b = u < v ? v : u;
-            h->dir = u < v ? 1 : -1;
-            h->tri = t;
-        }
-    qsort(e, ne, sizeof *e, half_edge_cmp);
-    for (size_t i = 0; i < ne;) {
-        size_t j = i;
-        while (j < ne && e[j].a == e[i].a && e[j].b == e[i].b)
-            j++;
-        if (j - i == 1) {
-            b[*n].from = e[i].dir > 0 ? e[i].a : e[i].b;
-            b[*n].to = e[i].dir > 0 ? e[i].b : e[i].a;
-            (*n)++;
-        }
-        i = j;
-    }
-    free(e);
-    qsort(b, (size_t)*n, sizeof *b, bedge_cmp);
-    return b;
-}
-
-/* Walks boundary half-edges into loops. For each closed loop calls fn with
- * its vertices in order (when fn is given). Returns the number of loops, or
- * -1 on memory. Half-edges that do not close a loop (inconsistent
- * orientation) are left alone. */
-typedef int (*loop_fn)(void *ctx, const int *v, int n);
-
-static int walk_loops(const cs_trimesh *m, loop_fn fn, void *ctx)
-{
-    int nb;
-    bedge *b = boundary_edges(m, &nb);
-    if (!b)
-        return m->nt > 0 ? -1 : 0;
-    int *start = malloc(((size_t)m->nv + 1) * sizeof *start);
-    unsigned char *done = calloc((size_t)nb + 1, 1);
-    int *loop = malloc(((size_t)nb + 1) * sizeof *loop);
-    int loops = 0;
-    if (!start || !done || !loop) {
-        loops = -1;
-        goto out;
-    }
-    for (int i = 0; i <= m->nv; i++)
-        start[i] = nb;
-    for (int i = nb - 1; i >= 0; i--)
-        start[b[i].from] = i;
-    for (int s = 0; s < nb; s++) {
-        if (done[s])
-            continue;
-        /* follow unused half-edges from b[s].from until back at it */
-        int n = 0, cur = s;
-        bool closed = false;
-        while (cur < nb && !done[cur]) {
-            done[cur] = 1;
-            loop[n++] = b[cur].from;
-            if (b[cur].to == b[s].from) {
-                closed = true;
-                break;
-            }
-            int v = b[cur].to, next = nb;
-            for (int k = start[v]; k < nb && b[k].from == v; k++)
-                if (!done[k]) {
-                    next = k;
-                    break;
-                }
-            cur = next;
-        }
-        if (closed && n >= 3) {
-            loops++;
-            if (fn && fn(ctx, loop, n) != 0) {
-                loops = -1;
-                goto out;
-            }
-        } else if (closed) {
-            loops++; /* a two-edge loop (a slit): nothing to fill */
-        }
-    }
-out:
-    free(b);
-    free(start);
-    free(done);
-    free(loop);
-    return loops;
-}
-
-void cs_mesh_analyse(const cs_trimesh *m, cs_mesh_report *r)
-{
-    r->boundary_edges = r->nonmanifold_edges = r->inconsistent_edges = 0;
-    r->boundary_loops = r->parts = 0;
-    r->area = r->volume = 0;
-    for (int k = 0; k < 3; k++) {
-        r->min[k] = m->nv > 0 ? INFINITY : 0;
-        r->max[k] = m->nv > 0 ? -INFINITY : 0;
-    }
-    for (int i = 0; i < m->nv; i++)
-        for (int k = 0; k < 3; k++) {
-            r->min[k] = fmin(r->min[k], m->x[3 * i + k]);
-            r->max[k] = fmax(r->max[k], m->x[3 * i + k]);
-        }
-    r->vertices = m->nv;
-    r->triangles = m->nt;
-    for (int t = 0; t < m->nt; t++) {
-        double cr[3];
-        const double *a = m->x + 3 * m->tri[3 * t];
-        r->area += 0.5 * tri_area2(m->x, m->tri + 3 * t, cr);
-        r->volume += (a[0] * cr[0] + a[1] * cr[1] + a[2] * cr[2]) / 6.0;
-    }
-    r->volume = fabs(r->volume);
-
-    size_t ne = 3 * (size_t)m->nt;
-    half_edge *e = malloc((ne + 1) * sizeof *e);
-    int *parent = malloc(((size_t)m->nv + 1) * sizeof *parent);
-    if (e && parent) {
-        for (int t = 0; t < m->nt; t++)
-            for (int k = 0; k < 3; k++) {
-                int u = m->tri[3 * t + k], v = m->tri[3 * t + (k + 1) % 3];
-                half_edge *h = &e[3 * t + k];
-                h->a = u < v ? u : v;
-                h->b = u < v ? v : u;
-                h->dir = u < v ? 1 : -1;
-                h->tri = t;
-            }
-        qsort(e, ne, sizeof *e, half_edge_cmp);
-        for (size_t i = 0; i < ne;) {
-            size_t j = i;
-            while (j < ne && e[j].a == e[i].a && e[j].b == e[i].b)
-                j++;
-            if (j - i == 1)
-                r->boundary_edges++;
-            else if (j - i > 2)
-                r->nonmanifold_edges++;
-            else if (e[i].dir == e[i + 1].dir)
-                r->inconsistent_edges++;
-            i = j;
-        }
-        for (int i = 0; i < m->nv; i++)
-            parent[i] = i;
-        for (int t = 0; t < m->nt; t++) {
-            int a = find_root(parent, m->tri[3 * t]);
-            for (int k = 1; k < 3; k++) {
-                int b = find_root(parent, m->tri[3 * t + k]);
-                if (a != b)
-                    parent[b] = a;
-            }
-        }
-        for (int i = 0; i < m->nv; i++)
-            r->parts += parent[i] == i;
-    }
-    free(e);
-    free(parent);
-    int loops = walk_loops(m, NULL, NULL);
-    r->boundary_loops = loops > 0 ? loops : 0;
-    r->closed = r->boundary_edges == 0 && r->nonmanifold_edges == 0;
-}
-
-/* ---------------------------------------------------------- hole filling */
-
-typedef struct fill_state {
-    int filled;
-    double *x;
-    int nv, cap_v;
-    int *tri;
-    int nt, cap_t;
-} fill_state;
-
-static int fill_loop(void *ctx, const int *v, int n)
-{
-    fill_state *f = ctx;
-    if (f->nv + 1 > f->cap_v || f->nt + n > f->cap_t) {
-        int cv = 2 * (f->nv + 1), ct = 2 * (f->nt + n);
-        double *x = realloc(f->x, 3 * (size_t)cv * sizeof *x);
-        if (!x)
-            return -1;
-        f->x = x;
-        int *t = realloc(f->tri, 3 * (size_t)ct * sizeof *t);
-        if (!t)
-            return -1;
-        f->tri = t;
-        f->cap_v = cv;
-        f->cap_t = ct;
-    }
-    double c[3] = {0, 0, 0};
-    for (int i = 0; i < n; i++)
-        for (int k = 0; k < 3; k++)
-            c[k] += f->x[3 * v[i] + k] / n;
-    int ci = f->nv++;
-    f->filled++;
-    memcpy(f->x + 3 * ci, c, sizeof c);
-    /* The loop runs the way its triangles walk their boundary edges; the
-     * fan walks each edge the other way, as a neighbour must. */
-    for (int i = 0; i < n; i++) {
-        int *t = f->tri + 3 * f->nt++;
-        t[0] = v[(i + 1) % n];
-        t[1] = v[i];
-        t[2] = ci;
-    }
-    return 0;
-}
-
-int cs_mesh_close_holes(cs_trimesh **mesh)
-{
-    cs_trimesh *m = *mesh;
-    fill_state f = {0};
-    f.nv = f.cap_v = m->nv;
-    f.nt = f.cap_t = m->nt;
-    f.x = malloc(3 * ((size_t)m->nv + 1) * sizeof *f.x);
-    f.tri = malloc(3 * ((size_t)m->nt + 1) * sizeof *f.tri);
-    if (!f.x || !f.tri) {
-        free(f.x);
-        free(f.tri);
-        return -1;
-    }
-    memcpy(f.x, m->x, 3 * (size_t)m->nv * sizeof *f.x);
-    memcpy(f.tri, m->tri, 3 * (size_t)m->nt * sizeof *f.tri);
-    int loops = walk_loops(m, fill_loop, &f);
-    if (loops > 0 && f.filled > 0) {
-        cs_trimesh *out = cs_trimesh_create(f.nv, f.nt);
-        if (!out) {
-            loops = -1;
-        } else {
-            memcpy(out->x, f.x, 3 * (size_t)f.nv * sizeof *f.x);
-            memcpy(out->tri, f.tri, 3 * (size_t)f.nt * sizeof *f.tri);
-            cs_trimesh_destroy(m);
-            *mesh = out;
-        }
-    }
-    free(f.x);
-    free(f.tri);
-    return loops < 0 ? -1 : f.filled;
-}
-
 /* ---------------------------------------------------------- import */
 
 static void place_point(const cs_mesh_placement *p, double unit, const double in[3], double out[3])
@@ -761,13 +316,14 @@ static void place_point(const cs_mesh_placement *p, double unit, const double in
 /* The read-and-merge phase shared by cs_mesh_import and cs_mesh_read: the
  * selected meshes (node NULL: all) of an opened scene, node transforms
  * applied, in file units, vertex order as the file has it; the walk's
- * counters in stats. */
+ * counters in stats. With keep_points, meshes without triangles give
+ * their vertices (a point cloud is a valid frame). */
 static int read_merged(const struct aiScene *scene, const char *path, const char *node,
-                       double **x_out, long *nv_out, int **tri_out, long *nt_out,
-                       int *file_nodes, walk_state *stats, char *err, size_t errlen)
+                       bool keep_points, double **x_out, long *nv_out, int **tri_out,
+                       long *nt_out, int *file_nodes, walk_state *stats, char *err, size_t errlen)
 {
     static const double identity[16] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
-    walk_state st = {.scene = scene, .node = node, .bad_vertex = -1};
+    walk_state st = {.scene = scene, .node = node, .bad_vertex = -1, .keep_points = keep_points};
     walk(&st, scene->mRootNode, identity, node == NULL, 0);
     *file_nodes = st.nodes;
     int rc = CS_IMPORT_BAD_INPUT;
@@ -793,18 +349,22 @@ static int read_merged(const struct aiScene *scene, const char *path, const char
                 path, node, count ? names : "no named nodes");
         goto fail;
     }
-    if (st.nt == 0) {
-        set_err(err, errlen, "%s holds no triangles%s", path,
-                st.skipped ? " (only points or lines)"
-                           : " (is it empty or truncated, or only points or lines?)");
+    if (keep_points ? st.nv == 0 : st.nt == 0) {
+        if (keep_points)
+            set_err(err, errlen, "%s holds no triangles and no point cloud%s", path,
+                    st.skipped ? " (only lines?)" : " (is it empty or truncated?)");
+        else
+            set_err(err, errlen, "%s holds no triangles%s", path,
+                    st.skipped ? " (only points or lines)"
+                               : " (is it empty or truncated, or only points or lines?)");
         goto fail;
     }
     if (st.nv > INT32_MAX / 3 || st.nt > INT32_MAX / 3) {
         set_err(err, errlen, "%s is too large (%ld vertices, %ld triangles)", path, st.nv, st.nt);
         goto fail;
     }
-    x = malloc(3 * (size_t)st.nv * sizeof *x);
-    tri = malloc(3 * (size_t)st.nt * sizeof *tri);
+    x = malloc((3 * (size_t)st.nv + 1) * sizeof *x);
+    tri = malloc((3 * (size_t)st.nt + 1) * sizeof *tri);
     if (!x || !tri) {
         set_err(err, errlen, "%s: out of memory for %ld vertices", path, st.nv);
         rc = CS_IMPORT_NOMEM;
@@ -828,74 +388,144 @@ fail:
     return rc;
 }
 
-cs_trimesh *cs_mesh_read(const char *path, char *err, size_t errlen)
+/* A mesh through the guard's pipe, and back (checked: a child that was
+ * cut short never gets here, but indices are cheap to check). */
+static void put_mesh(cs_bytes *b, const cs_trimesh *m)
 {
-    /* assimp joins identical vertices (an OBJ lists them per corner) but
-     * nothing is repaired or reordered: frames read back as written */
-    const struct aiScene *scene =
-        open_scene(path, aiProcess_Triangulate | aiProcess_JoinIdenticalVertices, err, errlen);
-    if (!scene)
+    int32_t n[2] = {m->nv, m->nt};
+    cs_bytes_put(b, n, sizeof n);
+    cs_bytes_put(b, m->x, 3 * (size_t)m->nv * sizeof *m->x);
+    cs_bytes_put(b, m->tri, 3 * (size_t)m->nt * sizeof *m->tri);
+}
+
+static cs_trimesh *get_mesh(cs_bytes_reader *r)
+{
+    int32_t n[2];
+    cs_bytes_get(r, n, sizeof n);
+    if (r->bad || n[0] < 0 || n[1] < 0 || n[0] > INT32_MAX / 3 || n[1] > INT32_MAX / 3 ||
+        (size_t)n[0] * 24 + (size_t)n[1] * 12 > r->left)
         return NULL;
+    cs_trimesh *m = cs_trimesh_create(n[0], n[1]);
+    if (!m)
+        return NULL;
+    cs_bytes_get(r, m->x, 3 * (size_t)n[0] * sizeof *m->x);
+    cs_bytes_get(r, m->tri, 3 * (size_t)n[1] * sizeof *m->tri);
+    for (int i = 0; i < 3 * m->nt; i++)
+        if (m->tri[i] < 0 || m->tri[i] >= m->nv)
+            r->bad = true;
+    if (r->bad) {
+        cs_trimesh_destroy(m);
+        return NULL;
+    }
+    return m;
+}
+
+/* In the child: a file as written, every mesh merged. */
+static int read_in_child(void *ctx, cs_bytes *out, char *err, size_t errlen)
+{
+    const char *path = ctx;
+    const struct aiScene *scene;
+    int rc = open_scene(path, aiProcess_Triangulate, true, &scene, err, errlen);
+    if (rc != CS_IMPORT_OK)
+        return rc;
     double *x = NULL;
     int *tri = NULL;
     long nv = 0, nt = 0;
     int nodes;
     walk_state st;
-    cs_trimesh *m = NULL;
-    if (read_merged(scene, path, NULL, &x, &nv, &tri, &nt, &nodes, &st, err, errlen) ==
-        CS_IMPORT_OK) {
-        if (st.bad_vertex >= 0)
-            set_err(err, errlen, "%s: vertex %d has a non-finite coordinate", path,
-                    st.bad_vertex);
-        else if (!(m = cs_trimesh_create((int)nv, (int)nt)))
-            set_err(err, errlen, "%s: out of memory", path);
-        else {
-            memcpy(m->x, x, sizeof *x * 3 * (size_t)nv);
-            memcpy(m->tri, tri, sizeof *tri * 3 * (size_t)nt);
-        }
+    rc = read_merged(scene, path, NULL, true, &x, &nv, &tri, &nt, &nodes, &st, err, errlen);
+    if (rc == CS_IMPORT_OK && st.bad_vertex >= 0) {
+        set_err(err, errlen, "%s: vertex %d has a non-finite coordinate", path, st.bad_vertex);
+        rc = CS_IMPORT_BAD_INPUT;
     }
+    if (rc == CS_IMPORT_OK)
+        put_mesh(out, &(cs_trimesh){(int)nv, (int)nt, x, tri});
     free(x);
     free(tri);
     aiReleaseImport(scene);
+    return rc;
+}
+
+cs_trimesh *cs_mesh_read(const char *path, char *err, size_t errlen)
+{
+    /* Nothing is repaired or reordered: frames read back as written. PLY
+     * and glTF keep the writer's vertex numbering; formats that list
+     * vertices per corner (OBJ, STL) have identical ones joined by assimp. */
+    cs_bytes res;
+    if (cs_guard_run(path, read_in_child, (void *)path, &res, err, errlen) != CS_IMPORT_OK) {
+        cs_bytes_free(&res);
+        return NULL;
+    }
+    cs_bytes_reader r = {res.data, res.len, false};
+    cs_trimesh *m = get_mesh(&r);
+    cs_bytes_free(&res);
+    if (!m)
+        set_err(err, errlen, "%s: out of memory", path);
     return m;
 }
 
-int cs_mesh_import(const char *path, const cs_mesh_placement *place, cs_trimesh **out,
-                   cs_mesh_report *report, char *err, size_t errlen)
+/* A warning when a mesh read in a format without units is an implausible
+ * size for a cloth or a body: an STL in millimetres comes out hundreds of
+ * metres wide. */
+static void check_size(const cs_mesh_report *r, char *out, size_t len)
 {
-    cs_mesh_report scratch;
-    cs_mesh_report *r = report ? report : &scratch;
-    cs_mesh_placement def = cs_default_mesh_placement();
-    const cs_mesh_placement *p = place ? place : &def;
-    memset(r, 0, sizeof *r);
-    *out = NULL;
+    double size = 0;
+    for (int k = 0; k < 3; k++)
+        size = fmax(size, r->max[k] - r->min[k]);
+    if (size > 20)
+        snprintf(out, len, "the mesh is %.3g m across, its numbers taken as metres (the format "
+                 "has no units): if it is in millimetres or centimetres, set units: mm or cm "
+                 "on the mesh in the scene (mesh-info: --units)", size);
+    else if (size < 0.005)
+        snprintf(out, len, "the mesh is %.3g m across, its numbers taken as metres (the format "
+                 "has no units): if it is in other units, set units: (m, cm, mm, km, in or ft) "
+                 "on the mesh in the scene (mesh-info: --units)", size);
+}
 
-    /* Only triangulation: joining is done by position below, after the NaN
-     * check, and degenerate triangles are counted. */
-    const struct aiScene *scene = open_scene(path, aiProcess_Triangulate, err, errlen);
-    if (!scene)
-        return CS_IMPORT_BAD_INPUT;
-    format_name(scene, path, r->format, sizeof r->format);
-    r->file_meshes = (int)scene->mNumMeshes;
-    double unit = file_units(scene, r->format, r->units, sizeof r->units);
-    if (p->unit_scale > 0) {
-        unit = p->unit_scale;
-        snprintf(r->units, sizeof r->units, "%g m per unit (as the scene says)", unit);
-    }
-    r->unit_scale = unit;
+typedef struct import_job {
+    const char *path;
+    const cs_mesh_placement *place;
+} import_job;
 
+/* In the child: the whole import; the report goes back even on failure
+ * (the scene blames the node key when the file has no such node). */
+static int import_in_child(void *ctx, cs_bytes *out, char *err, size_t errlen)
+{
+    const import_job *job = ctx;
+    const char *path = job->path;
+    const cs_mesh_placement *p = job->place;
+    cs_mesh_report r;
+    memset(&r, 0, sizeof r);
+    cs_trimesh *m = NULL;
     double *x = NULL;
     int *tri = NULL;
+    /* Only triangulation: joining is done by position below, after the NaN
+     * check, and degenerate triangles are counted. */
+    const struct aiScene *scene = NULL;
+    int rc = open_scene(path, aiProcess_Triangulate, false, &scene, err, errlen);
+    if (rc != CS_IMPORT_OK)
+        goto done;
+    format_name(scene, path, r.format, sizeof r.format);
+    r.file_meshes = (int)scene->mNumMeshes;
+    bool unitless;
+    double unit = file_units(scene, r.format, r.units, sizeof r.units, &unitless);
+    if (p->unit_scale > 0) {
+        unit = p->unit_scale;
+        unitless = false;
+        snprintf(r.units, sizeof r.units, "%g m per unit (as the scene says)", unit);
+    }
+    r.unit_scale = unit;
+
     long nv = 0, nt = 0;
     walk_state st;
-    int rc = read_merged(scene, path, p->node, &x, &nv, &tri, &nt, &r->file_nodes, &st, err,
-                         errlen);
+    rc = read_merged(scene, path, p->node, false, &x, &nv, &tri, &nt, &r.file_nodes, &st, err,
+                     errlen);
     if (rc != CS_IMPORT_OK)
         goto done;
     rc = CS_IMPORT_BAD_INPUT;
-    r->instances = (int)st.instances;
-    r->triangles_read = nt;
-    r->skipped_primitives = st.skipped;
+    r.instances = (int)st.instances;
+    r.triangles_read = nt;
+    r.skipped_primitives = st.skipped;
     if (st.bad_vertex >= 0) {
         set_err(err, errlen, "%s: vertex %d has a non-finite coordinate (NaN or infinity)", path,
                 st.bad_vertex);
@@ -910,41 +540,67 @@ int cs_mesh_import(const char *path, const cs_mesh_placement *place, cs_trimesh 
         }
         memcpy(x + 3 * i, q, sizeof q);
     }
-    cs_trimesh *m = clean(x, (int)nv, tri, (int)nt, r);
-    if (!m) {
+    if (!(m = cs_mesh_clean(x, (int)nv, tri, (int)nt, &r))) {
         set_err(err, errlen, "%s: out of memory", path);
         rc = CS_IMPORT_NOMEM;
         goto done;
     }
+    int kept = (int)nv - r.welded_vertices;
     if (m->nt == 0) {
         set_err(err, errlen, "%s has no triangles of nonzero area (%d degenerate)", path,
-                r->degenerate_triangles);
-        cs_trimesh_destroy(m);
+                r.degenerate_triangles);
         goto done;
     }
-    cs_mesh_analyse(m, r);
-    *out = m;
+    if (2 * r.unreferenced_vertices > kept) {
+        /* cow.ply: triangle strips the reader turns into one triangle */
+        set_err(err, errlen, "most of %s was not understood: its %d triangle%s use%s %d of its "
+                "%d vertices (triangle strips, or primitives the reader skips?)", path, m->nt,
+                m->nt == 1 ? "" : "s", m->nt == 1 ? "s" : "", m->nv, kept);
+        goto done;
+    }
+    cs_mesh_analyse(m, &r);
+    if (unitless)
+        check_size(&r, r.size_warning, sizeof r.size_warning);
     rc = CS_IMPORT_OK;
 done:
+    cs_bytes_put(out, &r, sizeof r);
+    if (rc == CS_IMPORT_OK)
+        put_mesh(out, m);
+    cs_trimesh_destroy(m);
     free(x);
     free(tri);
-    aiReleaseImport(scene);
+    if (scene)
+        aiReleaseImport(scene);
+    return rc;
+}
+
+int cs_mesh_import(const char *path, const cs_mesh_placement *place, cs_trimesh **out,
+                   cs_mesh_report *report, char *err, size_t errlen)
+{
+    cs_mesh_report scratch;
+    cs_mesh_report *r = report ? report : &scratch;
+    cs_mesh_placement def = cs_default_mesh_placement();
+    import_job job = {path, place ? place : &def};
+    memset(r, 0, sizeof *r);
+    *out = NULL;
+    cs_bytes res;
+    int rc = cs_guard_run(path, import_in_child, &job, &res, err, errlen);
+    cs_bytes_reader rd = {res.data, res.len, false};
+    if (res.len)
+        cs_bytes_get(&rd, r, sizeof *r);
+    if (rc == CS_IMPORT_OK && !(*out = get_mesh(&rd))) {
+        set_err(err, errlen, "%s: out of memory", path);
+        rc = CS_IMPORT_NOMEM;
+    }
+    cs_bytes_free(&res);
     return rc;
 }
 
 /* ---------------------------------------------------------- catalog */
 
-static char *dup_name(const struct aiString *s)
-{
-    size_t n = s->length < MAXLEN ? s->length : MAXLEN - 1;
-    char *d = malloc(n + 1);
-    if (d) {
-        memcpy(d, s->data, n);
-        d[n] = '\0';
-    }
-    return d;
-}
-
+/* The catalog travels as: format; node count, then per node (depth first)
+ * name, depth, mesh count, mesh indices; mesh count, then per mesh name,
+ * vertices, triangles, other primitives. */
 static int count_nodes(const struct aiNode *n, int depth)
 {
     if (depth > 256)
@@ -955,64 +611,115 @@ static int count_nodes(const struct aiNode *n, int depth)
     return c;
 }
 
-static bool fill_nodes(cs_mesh_catalog *c, const struct aiNode *n, int depth, int nmeshes)
+static void put_nodes(cs_bytes *b, const struct aiNode *n, int32_t depth, unsigned nmeshes)
 {
     if (depth > 256)
-        return true;
-    cs_mesh_catalog_node *out = &c->nodes[c->nnodes++];
-    out->name = dup_name(&n->mName);
-    out->depth = depth;
-    out->meshes = malloc(((size_t)n->mNumMeshes + 1) * sizeof *out->meshes);
-    if (!out->name || !out->meshes)
-        return false;
+        return;
+    int32_t count = 0;
     for (unsigned i = 0; i < n->mNumMeshes; i++)
-        if ((int)n->mMeshes[i] < nmeshes)
-            out->meshes[out->nmeshes++] = (int)n->mMeshes[i];
+        count += n->mMeshes[i] < nmeshes;
+    cs_bytes_put_str(b, n->mName.data);
+    cs_bytes_put(b, &depth, sizeof depth);
+    cs_bytes_put(b, &count, sizeof count);
+    for (unsigned i = 0; i < n->mNumMeshes; i++)
+        if (n->mMeshes[i] < nmeshes) {
+            int32_t m = (int32_t)n->mMeshes[i];
+            cs_bytes_put(b, &m, sizeof m);
+        }
     for (unsigned i = 0; i < n->mNumChildren; i++)
-        if (!fill_nodes(c, n->mChildren[i], depth + 1, nmeshes))
+        put_nodes(b, n->mChildren[i], depth + 1, nmeshes);
+}
+
+static int catalog_in_child(void *ctx, cs_bytes *out, char *err, size_t errlen)
+{
+    const char *path = ctx;
+    const struct aiScene *scene;
+    int rc = open_scene(path, aiProcess_Triangulate, false, &scene, err, errlen);
+    if (rc != CS_IMPORT_OK)
+        return rc;
+    char format[64];
+    format_name(scene, path, format, sizeof format);
+    cs_bytes_put_str(out, format);
+    int32_t n = count_nodes(scene->mRootNode, 0);
+    cs_bytes_put(out, &n, sizeof n);
+    put_nodes(out, scene->mRootNode, 0, scene->mNumMeshes);
+    n = (int32_t)scene->mNumMeshes;
+    cs_bytes_put(out, &n, sizeof n);
+    for (unsigned m = 0; m < scene->mNumMeshes; m++) {
+        const struct aiMesh *mesh = scene->mMeshes[m];
+        int32_t c[3] = {(int32_t)mesh->mNumVertices, 0, 0};
+        for (unsigned f = 0; f < mesh->mNumFaces; f++)
+            c[mesh->mFaces[f].mNumIndices == 3 ? 1 : 2]++;
+        cs_bytes_put_str(out, mesh->mName.data);
+        cs_bytes_put(out, c, sizeof c);
+    }
+    aiReleaseImport(scene);
+    return CS_IMPORT_OK;
+}
+
+/* A count of records of at least min bytes each that the reader can hold. */
+static int get_count(cs_bytes_reader *r, size_t min)
+{
+    int32_t n;
+    cs_bytes_get(r, &n, sizeof n);
+    if (n < 0 || (size_t)n > r->left / min)
+        r->bad = true;
+    return r->bad ? 0 : n;
+}
+
+static bool get_catalog(cs_bytes_reader *r, cs_mesh_catalog *c)
+{
+    cs_bytes_get_str(r, c->format, sizeof c->format);
+    int nn = get_count(r, 12);
+    if (!(c->nodes = calloc((size_t)nn + 1, sizeof *c->nodes)))
+        return false;
+    for (int i = 0; i < nn && !r->bad; i++) {
+        cs_mesh_catalog_node *node = &c->nodes[c->nnodes++];
+        node->name = cs_bytes_get_strdup(r);
+        cs_bytes_get(r, &node->depth, sizeof node->depth);
+        int k = get_count(r, 4);
+        if (!node->name || !(node->meshes = malloc(((size_t)k + 1) * sizeof *node->meshes)))
             return false;
-    return true;
+        cs_bytes_get(r, node->meshes, (size_t)k * sizeof *node->meshes);
+        node->nmeshes = k;
+    }
+    int nm = get_count(r, 16);
+    if (!(c->meshes = calloc((size_t)nm + 1, sizeof *c->meshes)))
+        return false;
+    for (int i = 0; i < nm && !r->bad; i++) {
+        cs_mesh_catalog_mesh *mesh = &c->meshes[c->nmeshes++];
+        int32_t counts[3];
+        mesh->name = cs_bytes_get_strdup(r);
+        cs_bytes_get(r, counts, sizeof counts);
+        if (!mesh->name)
+            return false;
+        mesh->vertices = counts[0];
+        mesh->triangles = counts[1];
+        mesh->other_primitives = counts[2];
+    }
+    return !r->bad;
 }
 
 int cs_mesh_catalog_read(const char *path, cs_mesh_catalog **out, char *err, size_t errlen)
 {
     *out = NULL;
-    const struct aiScene *scene = open_scene(path, aiProcess_Triangulate, err, errlen);
-    if (!scene)
-        return CS_IMPORT_BAD_INPUT;
-    cs_mesh_catalog *c = calloc(1, sizeof *c);
-    int total = count_nodes(scene->mRootNode, 0);
-    if (!c)
-        goto nomem;
-    format_name(scene, path, c->format, sizeof c->format);
-    c->nodes = calloc((size_t)total + 1, sizeof *c->nodes);
-    c->meshes = calloc((size_t)scene->mNumMeshes + 1, sizeof *c->meshes);
-    if (!c->nodes || !c->meshes)
-        goto nomem;
-    for (unsigned m = 0; m < scene->mNumMeshes; m++) {
-        const struct aiMesh *mesh = scene->mMeshes[m];
-        cs_mesh_catalog_mesh *cm = &c->meshes[c->nmeshes++];
-        cm->name = dup_name(&mesh->mName);
-        if (!cm->name)
-            goto nomem;
-        cm->vertices = (int)mesh->mNumVertices;
-        for (unsigned f = 0; f < mesh->mNumFaces; f++) {
-            if (mesh->mFaces[f].mNumIndices == 3)
-                cm->triangles++;
-            else
-                cm->other_primitives++;
-        }
+    cs_bytes res;
+    int rc = cs_guard_run(path, catalog_in_child, (void *)path, &res, err, errlen);
+    if (rc != CS_IMPORT_OK) {
+        cs_bytes_free(&res);
+        return rc;
     }
-    if (!fill_nodes(c, scene->mRootNode, 0, (int)scene->mNumMeshes))
-        goto nomem;
-    aiReleaseImport(scene);
-    *out = c;
-    return CS_IMPORT_OK;
-nomem:
-    aiReleaseImport(scene);
-    cs_mesh_catalog_destroy(c);
-    set_err(err, errlen, "%s: out of memory", path);
-    return CS_IMPORT_NOMEM;
+    cs_bytes_reader r = {res.data, res.len, false};
+    cs_mesh_catalog *c = calloc(1, sizeof *c);
+    if (c && get_catalog(&r, c)) {
+        *out = c;
+    } else {
+        cs_mesh_catalog_destroy(c);
+        set_err(err, errlen, "%s: out of memory", path);
+        rc = CS_IMPORT_NOMEM;
+    }
+    cs_bytes_free(&res);
+    return rc;
 }
 
 void cs_mesh_catalog_destroy(cs_mesh_catalog *c)

@@ -6,11 +6,10 @@
  * hands it to aiExportScene. Assimp copies the scene before touching it, so
  * the scene here is allocated and freed with malloc/free, never by assimp.
  *
- * Reading imports with triangulation and vertex joining and merges every
- * mesh instance of the node tree, node transforms applied, into one
- * cs_trimesh.
+ * Reading (cs_mesh_read, in mesh_import.c) merges every mesh instance of
+ * the node tree, node transforms applied, into one cs_trimesh.
  */
-#include "import/import.h"
+#include "import/mesh_internal.h"
 
 #include <assimp/cexport.h>
 #include <assimp/cimport.h>
@@ -30,15 +29,7 @@
 
 /* ------------------------------------------------------------- messages */
 
-static void set_err(char *err, size_t errlen, const char *fmt, ...)
-{
-    if (!err || errlen == 0)
-        return;
-    va_list ap;
-    va_start(ap, fmt);
-    vsnprintf(err, errlen, fmt, ap);
-    va_end(ap);
-}
+#define set_err cs_mesh_set_err
 
 /* -------------------------------------------------------------- formats */
 
@@ -182,12 +173,17 @@ static void set_normals(const cs_mesh_view *view, struct aiVector3D *normals)
     free(n);
 }
 
+/* A mesh without triangles is points, a one-corner face per vertex: the
+ * exporters write only what faces use (OBJ "p", glTF POINTS), and drop a
+ * mesh without faces (PLY). */
 static struct aiMesh *build_mesh(const cs_mesh_view *view, int index)
 {
     struct aiMesh *mesh = calloc(1, sizeof *mesh);
     if (!mesh)
         return NULL;
-    mesh->mPrimitiveTypes = aiPrimitiveType_TRIANGLE;
+    bool points = view->nt == 0;
+    int nfaces = points ? view->nv : view->nt;
+    mesh->mPrimitiveTypes = points ? aiPrimitiveType_POINT : aiPrimitiveType_TRIANGLE;
     mesh->mMaterialIndex = 0;
     if (view->name && *view->name) {
         set_ai_string(&mesh->mName, view->name);
@@ -199,28 +195,29 @@ static struct aiMesh *build_mesh(const cs_mesh_view *view, int index)
     mesh->mNumVertices = (unsigned)view->nv;
     mesh->mVertices = malloc((size_t)view->nv * sizeof *mesh->mVertices);
     mesh->mNormals = malloc((size_t)view->nv * sizeof *mesh->mNormals);
-    mesh->mFaces = calloc((size_t)view->nt, sizeof *mesh->mFaces);
+    mesh->mFaces = calloc((size_t)nfaces + 1, sizeof *mesh->mFaces);
     if (!mesh->mVertices || !mesh->mNormals || !mesh->mFaces) {
         free_mesh(mesh);
         return NULL;
     }
-    mesh->mNumFaces = (unsigned)view->nt;
+    mesh->mNumFaces = (unsigned)nfaces;
     for (int i = 0; i < view->nv; i++) {
         mesh->mVertices[i].x = (ai_real)view->x[3 * i + 0];
         mesh->mVertices[i].y = (ai_real)view->x[3 * i + 1];
         mesh->mVertices[i].z = (ai_real)view->x[3 * i + 2];
     }
     set_normals(view, mesh->mNormals);
-    for (int t = 0; t < view->nt; t++) {
+    for (int t = 0; t < nfaces; t++) {
         struct aiFace *face = &mesh->mFaces[t];
-        face->mIndices = malloc(3 * sizeof *face->mIndices);
+        unsigned corners = points ? 1 : 3;
+        face->mIndices = malloc(corners * sizeof *face->mIndices);
         if (!face->mIndices) {
             free_mesh(mesh);
             return NULL;
         }
-        face->mNumIndices = 3;
-        for (int k = 0; k < 3; k++)
-            face->mIndices[k] = (unsigned)view->tri[3 * t + k];
+        face->mNumIndices = corners;
+        for (unsigned k = 0; k < corners; k++)
+            face->mIndices[k] = points ? (unsigned)t : (unsigned)view->tri[3 * t + k];
     }
     return mesh;
 }
@@ -283,6 +280,32 @@ fail:
     return NULL;
 }
 
+/* A frame of points only as a point-cloud PLY: vertices, no faces. Written
+ * here because assimp's PLY exporter drops meshes without faces (its
+ * enforced PreTransformVertices step) and would need one-corner faces. */
+static bool ply_points(int nmeshes, const cs_mesh_view *meshes, cs_bytes *out)
+{
+    long nv = 0;
+    for (int m = 0; m < nmeshes; m++)
+        nv += meshes[m].nv;
+    char header[256];
+    int n = snprintf(header, sizeof header,
+                     "ply\nformat binary_little_endian 1.0\ncomment clothsim point cloud\n"
+                     "element vertex %ld\nproperty float x\nproperty float y\nproperty float z\n"
+                     "end_header\n", nv);
+    cs_bytes_put(out, header, (size_t)n);
+    for (int m = 0; m < nmeshes; m++)
+        for (int i = 0; i < 3 * meshes[m].nv; i++) {
+            float f = (float)meshes[m].x[i];
+            uint32_t bits;
+            memcpy(&bits, &f, sizeof bits);
+            unsigned char le[4] = {bits & 0xFF, (bits >> 8) & 0xFF, (bits >> 16) & 0xFF,
+                                   bits >> 24};
+            cs_bytes_put(out, le, sizeof le);
+        }
+    return !out->nomem;
+}
+
 /* Everything cs_mesh_write can check before assimp sees the data. */
 static bool check_views(const char *path, int nmeshes, const cs_mesh_view *meshes,
                         char *err, size_t errlen)
@@ -294,8 +317,8 @@ static bool check_views(const char *path, int nmeshes, const cs_mesh_view *meshe
     for (int m = 0; m < nmeshes; m++) {
         const cs_mesh_view *v = &meshes[m];
         const char *name = v->name ? v->name : "(unnamed)";
-        if (v->nv <= 0 || v->nt <= 0 || !v->x || !v->tri) {
-            set_err(err, errlen, "%s: mesh %d '%s' has no vertices or no triangles", path, m, name);
+        if (v->nv <= 0 || v->nt < 0 || !v->x || (v->nt > 0 && !v->tri)) {
+            set_err(err, errlen, "%s: mesh %d '%s' has no vertices", path, m, name);
             return false;
         }
         for (int i = 0; i < 3 * v->nt; i++) {
@@ -307,6 +330,24 @@ static bool check_views(const char *path, int nmeshes, const cs_mesh_view *meshe
         }
     }
     return true;
+}
+
+/* data as the file path, every write checked (fwrite, fflush, fclose).
+ * Returns 0, or -1 with errno. */
+static int write_checked(const char *path, const void *data, size_t size)
+{
+    errno = 0;
+    FILE *fp = fopen(path, "wb");
+    if (!fp)
+        return -1;
+    int failed = fwrite(data, 1, size, fp) != size || fflush(fp) != 0;
+    int saved = errno;
+    if (fclose(fp) != 0 && !failed) {
+        failed = 1;
+        saved = errno;
+    }
+    errno = saved ? saved : EIO;
+    return failed ? -1 : 0;
 }
 
 int cs_mesh_write(const char *path, cs_mesh_format format, int nmeshes,
@@ -342,31 +383,42 @@ int cs_mesh_write(const char *path, cs_mesh_format format, int nmeshes,
     }
     fclose(probe);
 
-    struct aiScene *scene = build_scene(nmeshes, meshes);
-    if (!scene) {
+    bool points_only = format == CS_MESH_PLY;
+    for (int m = 0; m < nmeshes; m++)
+        points_only = points_only && meshes[m].nt == 0;
+    cs_bytes points = {0};
+    struct aiScene *scene = points_only ? NULL : build_scene(nmeshes, meshes);
+    if (points_only ? !ply_points(nmeshes, meshes, &points) : !scene) {
         remove(tmp);
         free(tmp);
         set_err(err, errlen, "%s: out of memory", path);
         return CS_IMPORT_NOMEM;
     }
-    enum aiReturn r = aiExportScene(scene, FORMATS[format].assimp_id, tmp, 0);
+    /* Assimp exports into memory and the bytes are written here, every
+     * write checked: assimp's own file writer ignores a short fwrite and
+     * fclose's result, so a full disk gave a truncated frame (issue 12). */
+    const struct aiExportDataBlob *blob =
+        scene ? aiExportSceneToBlob(scene, FORMATS[format].assimp_id, 0) : NULL;
     free_scene(scene);
+    const void *data = blob ? blob->data : points.data;
+    size_t size = blob ? blob->size : points.len;
 
     int status = CS_IMPORT_OK;
-    struct stat st;
-    if (r != aiReturn_SUCCESS) {
+    if (!data || size == 0) {
         set_err(err, errlen, "cannot write %s: assimp's '%s' exporter failed",
                 path, FORMATS[format].assimp_id);
         status = CS_IMPORT_BAD_INPUT;
-    } else if (stat(tmp, &st) != 0 || st.st_size == 0) {
-        set_err(err, errlen, "cannot write %s: assimp's '%s' exporter wrote nothing",
-                path, FORMATS[format].assimp_id);
+    } else if (write_checked(tmp, data, size) != 0) {
+        set_err(err, errlen, "cannot write %s: %s", path, strerror(errno));
         status = CS_IMPORT_BAD_INPUT;
     } else if (rename(tmp, path) != 0) {
         set_err(err, errlen, "cannot write %s: rename from %s failed: %s",
                 path, tmp, strerror(errno));
         status = CS_IMPORT_BAD_INPUT;
     }
+    if (blob)
+        aiReleaseExportBlob(blob);
+    cs_bytes_free(&points);
     if (status != CS_IMPORT_OK)
         remove(tmp);
     free(tmp);

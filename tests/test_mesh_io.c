@@ -13,26 +13,10 @@
 #include <unistd.h>
 
 #include "import/import.h"
+#include "tests/tmpdir.h"
 
 /* Coordinates go through 32-bit floats (and OBJ through text). */
 #define TOL 1e-5
-
-static char tmpdir[256];
-
-static int setup_dir(void **state)
-{
-    (void)state;
-    snprintf(tmpdir, sizeof tmpdir, "/tmp/cs_test_mesh_io_XXXXXX");
-    return mkdtemp(tmpdir) ? 0 : -1;
-}
-
-static int remove_dir(void **state)
-{
-    (void)state;
-    char cmd[300];
-    snprintf(cmd, sizeof cmd, "rm -rf '%s'", tmpdir);
-    return system(cmd) == 0 ? 0 : -1;
-}
 
 static void path_in_dir(char *out, size_t len, const char *name)
 {
@@ -246,6 +230,45 @@ static void test_write_bad_input(void **state)
     assert_false(exists(path));
 }
 
+/* A cloth without triangles is written as points and read back (issue 12):
+ * alone, a point-cloud PLY of vertices only; beside a triangle mesh, in
+ * the same file. */
+static void test_points(void **state)
+{
+    (void)state;
+    fixture f;
+    make_fixture(&f);
+    const double px[6] = {0.5, 2.0, -1.0, 0.25, 2.5, -1.5};
+    cs_mesh_view views[2] = {{"particles", 2, px, 0, NULL}, f.views[1]};
+    const cs_mesh_format formats[3] = {CS_MESH_PLY, CS_MESH_OBJ, CS_MESH_GLB};
+    for (int i = 0; i < 3; i++)
+        for (int n = 1; n <= 2; n++) {
+            char name[32], path[512], err[512] = "";
+            snprintf(name, sizeof name, "points_%d.%s", n, cs_mesh_format_extension(formats[i]));
+            path_in_dir(path, sizeof path, name);
+            if (cs_mesh_write(path, formats[i], n, views, err, sizeof err) != CS_IMPORT_OK)
+                fail_msg("write %s: %s", path, err);
+            cs_trimesh *got = cs_mesh_read(path, err, sizeof err);
+            if (!got)
+                fail_msg("read %s: %s", path, err);
+            assert_int_equal(got->nv, n == 1 ? 2 : 6);
+            assert_int_equal(got->nt, n == 1 ? 0 : 4);
+            for (int d = 0; d < 6 && n == 1; d++)
+                assert_true(fabs(got->x[d] - px[d]) < TOL);
+            cs_trimesh_destroy(got);
+            if (formats[i] == CS_MESH_PLY && n == 1) {
+                char head[512] = "";
+                FILE *fp = fopen(path, "rb");
+                assert_non_null(fp);
+                size_t len = fread(head, 1, sizeof head - 1, fp);
+                fclose(fp);
+                head[len] = '\0';
+                assert_non_null(strstr(head, "element vertex 2\n"));
+                assert_null(strstr(head, "element face"));
+            }
+        }
+}
+
 static void write_text(const char *path, const char *text)
 {
     FILE *fp = fopen(path, "w");
@@ -339,9 +362,10 @@ int main(void)
         cmocka_unit_test(test_vertex_order_kept),
         cmocka_unit_test(test_write_bad_path),
         cmocka_unit_test(test_write_bad_input),
+        cmocka_unit_test(test_points),
         cmocka_unit_test(test_read_errors),
         cmocka_unit_test(test_read_non_finite),
         cmocka_unit_test(test_read_applies_transforms),
     };
-    return cmocka_run_group_tests(tests, setup_dir, remove_dir);
+    return cmocka_run_group_tests(tests, tmpdir_make, tmpdir_remove);
 }
