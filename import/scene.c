@@ -55,6 +55,9 @@ typedef struct loader {
     /* libcyaml's log of the current load. */
     char log[16384];
     size_t log_len;
+    /* for refusing a grid that cannot fit before tessellating it */
+    bool self_collision;
+    double particles;            /* of the cloths converted so far */
 } loader;
 
 /* ------------------------------------------------------------ messages */
@@ -820,6 +823,16 @@ static int convert_grid(loader *L, const cs_raw_grid *g, const char *base, int r
         return fail(L, p, false, "must give at most %d quads (got %d x %d)", INT_MAX / 6,
                     res[0], res[1]);
     }
+    /* Refused before the tessellation and the simulation allocate it (a
+     * 5000 x 5000 grid used to take 13.8 GB before anything said no). */
+    double particles = (double)(res[0] + 1) * (res[1] + 1), all = L->particles + particles;
+    char why[160];
+    if (!cs_memory_fits(cs_sim_estimate_bytes(all, L->self_collision), why, sizeof why)) {
+        snprintf(p, sizeof p, "%s.grid.resolution", base);
+        return fail(L, p, false, "%d x %d quads (%.3g particles%s) to simulate%s: %s", res[0],
+                    res[1], particles, all > particles ? " with the cloths before" : "",
+                    L->self_collision ? " with self-collision" : "", why);
+    }
     snprintf(p, sizeof p, "%s.grid.center", base);
     if ((rc = vec(L, g->center, 3, zero3, ANY, p, center)))
         return rc;
@@ -828,6 +841,7 @@ static int convert_grid(loader *L, const cs_raw_grid *g, const char *base, int r
         return rc;
     cs_quat_from_euler_degrees(deg, q);
     *mesh = cs_trimesh_create_grid(size, res, q, center);
+    L->particles = all;
     return *mesh ? CS_IMPORT_OK : CS_IMPORT_NOMEM;
 }
 
@@ -1005,6 +1019,8 @@ static bool note_mesh(cs_scene *s, const char *who, const char *file, const cs_m
                   base_name(file), r->format, r->units, r->triangles, r->vertices, r->parts,
                   r->parts == 1 ? "" : "s", r->closed ? "closed" : "open", fixes))
         return false;
+    if (r->size_warning[0] && !add_note(s, "warning: %s: %s", who, r->size_warning))
+        return false;
     if (r->nonmanifold_edges &&
         !add_note(s, "warning: %s: %d non-manifold edge%s (more than two triangles on an edge)%s",
                   who, r->nonmanifold_edges, r->nonmanifold_edges == 1 ? "" : "s",
@@ -1137,7 +1153,9 @@ static int convert_mesh_body(loader *L, const cs_raw_body *rb, int bi, cs_scene 
         snprintf(p, sizeof p, "%s.mesh", base);
         return fail(L, p, false, "must have triangles for a body");
     }
-    static const range at_least_one = {GE, 1, NONE, 0};
+    /* a band is a few voxels: beyond 1000 the default voxel size coarsens
+     * to nothing and the message would blame the voxel size */
+    static const range at_least_one = {GE, 1, GE, 1000};
     snprintf(p, sizeof p, "%s.voxel_size", base);
     if ((err = num(L, rb->voxel_size, 0, POSITIVE, p, &mb->voxel_size)))
         return err;
@@ -1347,6 +1365,9 @@ static int convert_body(loader *L, const cs_raw_body *rb, int bi, cs_scene *s)
     snprintf(p, sizeof p, "%s.friction", base);
     if ((err = num(L, rb->friction, bd->friction, NONNEG, p, &bd->friction)))
         return err;
+    snprintf(p, sizeof p, "%s.collision_offset", base);
+    if ((err = num(L, rb->collision_offset, bd->offset, NONNEG, p, &bd->offset)))
+        return err;
     snprintf(p, sizeof p, "%s.color", base);
     if ((err = vec(L, rb->color, 3, default_body_color, UNIT, p, s->body_colors + 3 * bi)))
         return err;
@@ -1366,6 +1387,9 @@ static int convert_time(loader *L, const cs_raw_time *t, cs_scene *s)
     static const range safety = {GT, 0, GE, 1};
     if ((rc = num(L, t->fps, d->fps, POSITIVE, "time.fps", &d->fps)) ||
         (rc = inum(L, t->frames, DEFAULT_FRAMES, 0, "time.frames", &s->frames)) ||
+        (rc = s->frames > CS_MAX_FRAMES
+                  ? fail(L, "time.frames", true, "must be at most %d", CS_MAX_FRAMES)
+                  : CS_IMPORT_OK) ||
         (rc = num(L, t->dt_safety, d->dt_safety, safety, "time.dt_safety", &d->dt_safety)) ||
         (rc = inum(L, t->collision_steps, d->collision_steps, 1, "time.collision_steps",
                    &d->collision_steps)) ||
@@ -1478,6 +1502,7 @@ static int convert_scene(loader *L, const cs_raw_scene *r, const char *default_n
         if (r->effects->friction)
             s->def.friction_method = (cs_friction_method)*r->effects->friction;
     }
+    L->self_collision = s->def.self_collision;
     if (r->self_collision) {
         const cs_raw_self *c = r->self_collision;
         cs_self_collision_def *d = &s->def.self;

@@ -68,6 +68,27 @@ static int parser_error(const yaml_parser_t *parser, const char *text, size_t le
     return CS_SDOC_BAD;
 }
 
+/* YAML allows a list or a mapping as a key ("? [a, b]"); a scene's keys
+ * are names, and libcyaml answers such a key with "Internal error". */
+static int plain_keys(const cs_sdoc *d, int *line, char *msg, size_t msglen)
+{
+    for (yaml_node_t *n = d->doc.nodes.start; n < d->doc.nodes.top; n++) {
+        if (n->type != YAML_MAPPING_NODE)
+            continue;
+        for (yaml_node_pair_t *p = n->data.mapping.pairs.start; p < n->data.mapping.pairs.top;
+             p++) {
+            const yaml_node_t *k = yaml_document_get_node((yaml_document_t *)&d->doc, p->key);
+            if (k && k->type != YAML_SCALAR_NODE) {
+                *line = (int)k->start_mark.line + 1;
+                snprintf(msg, msglen, "a key must be a plain name (got a %s)",
+                         k->type == YAML_SEQUENCE_NODE ? "list" : "mapping");
+                return CS_SDOC_BAD;
+            }
+        }
+    }
+    return CS_SDOC_OK;
+}
+
 int cs_sdoc_load(cs_sdoc *d, const char *text, size_t len, int *line, char *msg, size_t msglen)
 {
     yaml_parser_t parser;
@@ -97,6 +118,8 @@ int cs_sdoc_load(cs_sdoc *d, const char *text, size_t len, int *line, char *msg,
         yaml_document_delete(&extra);
     }
     yaml_parser_delete(&parser);
+    if (rc == CS_SDOC_OK)
+        rc = plain_keys(d, line, msg, msglen);
     if (rc == CS_SDOC_OK)
         rc = owner_sync(d);
     if (rc != CS_SDOC_OK)

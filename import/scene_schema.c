@@ -225,6 +225,7 @@ static const cyaml_schema_field_t body_fields[] = {
     VEC("size", OPT, cs_raw_body, size, 3),
     NUM("height", cs_raw_body, height),
     NUM("friction", cs_raw_body, friction),
+    NUM("collision_offset", cs_raw_body, collision_offset),
     VEC("color", OPT, cs_raw_body, color, 3),
     CYAML_FIELD_MAPPING_PTR("motion", OPT, cs_raw_body, motion, motion_fields),
     CYAML_FIELD_MAPPING_PTR("mesh", OPT, cs_raw_body, mesh, mesh_fields),

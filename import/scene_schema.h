@@ -141,6 +141,7 @@ typedef struct cs_raw_body {
     double *size;              /* 3 */
     double *height;
     double *friction;
+    double *collision_offset;
     double *color;             /* 3 */
     cs_raw_motion *motion;
     cs_raw_mesh *mesh;         /* mesh bodies */

@@ -1,6 +1,7 @@
 /* body_bounds.c: world boxes of bodies, for the partition of body
  * occupancy (body_grid.c). A box must hold every point where the body's
- * phi < 0; planes, and distance functions without a box, are unbounded. */
+ * phi < offset (where it collides); planes, and distance functions without
+ * a box, are unbounded. */
 #include "sim/sim.h"
 #include "sim/vec3.h"
 
@@ -50,7 +51,7 @@ bool cs_body_def_bounds(const cs_body_def *b, double t, double lo[3], double hi[
         double centre = c[i] + wmid[i];
         /* round-off of the pose and of phi must not push a point that phi
          * calls inside out of the box */
-        double pad = 1e-9 * (fabs(centre) + h) + 1e-12;
+        double pad = 1e-9 * (fabs(centre) + h) + 1e-12 + b->offset;
         lo[i] = centre - h - pad;
         hi[i] = centre + h + pad;
     }

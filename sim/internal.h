@@ -17,7 +17,16 @@ typedef struct cs_script_state {
     int nvertices;
     int *vertices;        /* global particle indices */
     double *local;        /* 3 per vertex: R(0)^T (x0 - c(0)) */
+    double radius;        /* the largest |local|: the farthest vertex */
 } cs_script_state;
+
+/* runaway.c: what instability detection knows (see there). */
+typedef struct cs_runaway {
+    double initial_speed, wave_speed; /* from the scene, fixed at creation */
+    double limit, limit2;             /* this step's bound on speed, m/s */
+    int stage;                        /* first stage past it; -1: none */
+    double speed;                     /* the speed seen there (inf: NaN) */
+} cs_runaway;
 
 typedef struct cs_cloth_state {
     char *name;
@@ -80,6 +89,7 @@ struct cs_sim {
     cs_comm_stats *rank_comm;     /* per rank totals */
     size_t stage_bytes[CS_STAGE_COUNT];
     long cg_iterations, contacts;
+    cs_runaway runaway;
 };
 
 /* mesh.c: sorts n (a, b) integer pairs lexicographically and drops the
@@ -97,6 +107,15 @@ int cs_cg_solve(cs_sim *sim, double *v0, const double *rhs, double *v, double *w
 void cs_system_apply(const cs_sim *sim, const double *v, double *out);
 /* out += D v (damping plus implicit wind drag). */
 void cs_damping_apply(const cs_sim *sim, const double *v, double *out);
+
+/* runaway.c: init after the step size and scripts are known; each step
+ * begins with the bound at its end time, checks v after each stage that
+ * makes a velocity, and ends with one reduction (false: unstable). */
+void cs_runaway_init(cs_sim *sim);
+double cs_runaway_limit(const cs_sim *sim, double t);
+void cs_runaway_begin_step(cs_sim *sim, double t1);
+void cs_runaway_check(cs_sim *sim, const double *v, cs_stage stage);
+bool cs_runaway_end_step(cs_sim *sim);
 
 /* contact.c: Section 6. */
 void cs_gamma(const double v[3], const double N[3], const double vb[3], double mu,

@@ -133,6 +133,8 @@ static int validate(const cs_sim_def *def, char *err, size_t errlen)
             return fail(err, errlen, "body %d: a mesh body needs its level set", b);
         if (!(body->friction >= 0))
             return fail(err, errlen, "body %d: friction must be >= 0", b);
+        if (!(body->offset >= 0 && isfinite(body->offset)))
+            return fail(err, errlen, "body %d: collision offset must be finite and >= 0", b);
     }
     return CS_OK;
 }
@@ -184,11 +186,20 @@ static void cloth_masses(const cs_cloth_def *cl, double *mass)
 
 cs_sim *cs_sim_create(const cs_sim_def *def, char *err, size_t errlen)
 {
+    cs_sim *sim = NULL;
+    cs_sim_create_checked(def, &sim, err, errlen);
+    return sim;
+}
+
+int cs_sim_create_checked(const cs_sim_def *def, cs_sim **out, char *err, size_t errlen)
+{
+    *out = NULL;
     if (validate(def, err, errlen) != CS_OK)
-        return NULL;
+        return CS_ERR_INVALID;
+    int status = CS_ERR_NOMEM;
     cs_sim *sim = calloc(1, sizeof *sim);
     if (!sim)
-        return NULL;
+        return fail(err, errlen, "out of memory creating a simulation"), CS_ERR_NOMEM;
     sim->def = *def;
     sim->plan = cs_plan_from_def(def);
     sim->def.cloths = NULL;
@@ -350,8 +361,21 @@ cs_sim *cs_sim_create(const cs_sim_def *def, char *err, size_t errlen)
     double dt_max = def->dt > 0 ? def->dt : def->dt_safety * sim->stable_dt;
     if (dt_max > frame)
         dt_max = frame;
-    int steps = (int)ceil(frame / dt_max - 1e-9);
-    sim->dt = frame / (steps > 0 ? steps : 1);
+    double steps = ceil(frame / dt_max - 1e-9); /* a double: 1/fps over 1e-308 fits */
+    if (!(steps <= CS_MAX_STEPS_PER_FRAME)) {
+        if (def->dt > 0)
+            fail(err, errlen,
+                 "time.dt is too small: %.3g s makes a frame of %.3g s %.3g steps (at most "
+                 "%d)", def->dt, frame, steps, CS_MAX_STEPS_PER_FRAME);
+        else
+            fail(err, errlen,
+                 "the stability limit of the cloths' springs is %.3g s, so a frame of %.3g s "
+                 "would need %.3g steps (at most %d); check the cloths' stiffness and mass",
+                 sim->stable_dt, frame, steps, CS_MAX_STEPS_PER_FRAME);
+        goto invalid;
+    }
+    sim->dt = frame / (steps >= 1 ? steps : 1);
+    cs_runaway_init(sim); /* from all springs and particles, like the step */
 
     sim->nsprings = sim->springs.n;
     /* Section 7: owners and ghosts; each rank keeps the springs it needs */
@@ -367,12 +391,17 @@ cs_sim *cs_sim_create(const cs_sim_def *def, char *err, size_t errlen)
         goto nomem;
     for (int i = 0; i < n; i++)
         sim->active[i] = sim->is_free[i] && cs_par_owns(sim->par, i);
-    return sim;
+    *out = sim;
+    return CS_OK;
 
 nomem:
     fail(err, errlen, "out of memory creating a simulation of %d particles", n);
+    goto failed;
+invalid:
+    status = CS_ERR_INVALID;
+failed:
     cs_sim_destroy(sim);
-    return NULL;
+    return status;
 }
 
 void cs_sim_destroy(cs_sim *sim)
@@ -497,18 +526,6 @@ static void copy_ranges(const int *ranges, int nranges, double *dst, const doubl
 }
 
 /* True on every rank when every owned particle is finite everywhere. */
-static bool state_finite(cs_sim *sim)
-{
-    double bad = 0;
-    cs_par_begin(sim->par, CS_STAGE_VELOCITY_FULL); /* B.6's result checked */
-    CS_FOR_OWNED(sim->par, i)
-        for (int d = 0; d < 3; d++)
-            if (!isfinite(sim->x[3 * i + d]) || !isfinite(sim->v[3 * i + d]))
-                bad = 1;
-    cs_par_max(sim->par, &bad, 1);
-    return bad == 0;
-}
-
 int cs_sim_step(cs_sim *sim, double dt)
 {
     cs_par *par = sim->par;
@@ -520,6 +537,7 @@ int cs_sim_step(cs_sim *sim, double dt)
     copy_ranges(par->local, par->nlocal, sim->x_prev, sim->x);
     CS_FOR_OWNED(par, i)
         sim->mode[i] = sim->is_free[i] ? CS_FREE : CS_FIXED;
+    cs_runaway_begin_step(sim, t1);
 
     if (sim->nscripts > 0) {
         STAGE_BEGIN(sim, CS_STAGE_SCRIPTED_VERTICES);
@@ -544,12 +562,14 @@ int cs_sim_step(cs_sim *sim, double dt)
     explicit_forces(sim, sim->x); /* prepares the springs' directions at x^n too */
     momentum_rhs(sim, sim->v);
     sim->cg_iterations += cs_cg_solve(sim, sim->v0, sim->rhs, sim->v_half, sim->cg.warm_half);
+    cs_runaway_check(sim, sim->v_half, CS_STAGE_VELOCITY_HALF);
     STAGE_END(sim, CS_STAGE_VELOCITY_HALF);
 
     /* B.2: repulsions change only the velocity that moves the positions */
     if (sim->selfcol) {
         STAGE_BEGIN(sim, CS_STAGE_SELF_REPULSION);
         cs_selfcol_repulse(sim, sim->x, sim->v_half, dt, true);
+        cs_runaway_check(sim, sim->v_half, CS_STAGE_SELF_REPULSION);
         STAGE_END(sim, CS_STAGE_SELF_REPULSION);
     }
 
@@ -569,6 +589,7 @@ int cs_sim_step(cs_sim *sim, double dt)
     if (bodies) {
         STAGE_BEGIN(sim, CS_STAGE_BODY_COLLISION);
         cs_body_collide(sim, dt);
+        cs_runaway_check(sim, sim->v_star, CS_STAGE_BODY_COLLISION);
         STAGE_END(sim, CS_STAGE_BODY_COLLISION);
     } else {
         copy_ranges(par->own, par->nown, sim->v_star, sim->v);
@@ -615,23 +636,26 @@ int cs_sim_step(cs_sim *sim, double dt)
     CS_FOR_OWNED(par, i)
         if (!sim->is_free[i])
             memcpy(sim->v_next + 3 * i, sim->script_v + 3 * i, 3 * sizeof(double));
+    cs_runaway_check(sim, sim->v_next, CS_STAGE_VELOCITY_FULL);
     STAGE_END(sim, CS_STAGE_VELOCITY_FULL);
 
     /* B.7 */
     if (bodies) {
         STAGE_BEGIN(sim, CS_STAGE_BODY_FRICTION);
         cs_body_friction(sim, dt);
+        cs_runaway_check(sim, sim->v_next, CS_STAGE_BODY_FRICTION);
         STAGE_END(sim, CS_STAGE_BODY_FRICTION);
     }
     /* B.8: inelastic repulsion and friction on the final velocity */
     if (sim->selfcol) {
         STAGE_BEGIN(sim, CS_STAGE_SELF_FRICTION);
         cs_selfcol_repulse(sim, sim->x, sim->v_next, dt, false);
+        cs_runaway_check(sim, sim->v_next, CS_STAGE_SELF_FRICTION);
         STAGE_END(sim, CS_STAGE_SELF_FRICTION);
     }
     copy_ranges(par->own, par->nown, sim->v, sim->v_next);
     sim->t = t1;
-    return state_finite(sim) ? CS_OK : CS_ERR_UNSTABLE;
+    return cs_runaway_end_step(sim) ? CS_OK : CS_ERR_UNSTABLE;
 }
 
 /* One outer collision step of k time steps (Section 4): step A, k steps of
@@ -677,8 +701,9 @@ static int outer_step(cs_sim *sim, int k)
         }
         STAGE_BEGIN(sim, CS_STAGE_COLLISIONS);
         cs_selfcol_collide(sim, sim->t - t0, k, false);
+        cs_runaway_check(sim, sim->v, CS_STAGE_COLLISIONS);
         STAGE_END(sim, CS_STAGE_COLLISIONS);
-        return state_finite(sim) ? CS_OK : CS_ERR_UNSTABLE;
+        return cs_runaway_end_step(sim) ? CS_OK : CS_ERR_UNSTABLE;
     }
 }
 

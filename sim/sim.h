@@ -121,6 +121,11 @@ typedef struct cs_body_def {
     double half_extents[3];
     double half_height;
     double friction;          /* Coulomb coefficient mu */
+    /* Collision offset, m: cloth vertices are kept this far outside the
+     * surface (phi >= offset), so that a coarse cloth resting on a curved
+     * or detailed body does not let the surface poke through between its
+     * vertices. 0: vertices on the surface itself (the paper). */
+    double offset;
     cs_motion motion;         /* where the local frame is over time */
     /* Optional: a user distance function replacing the analytic shape. */
     cs_body_phi_fn phi_fn;
@@ -139,8 +144,9 @@ double cs_body_def_phi(const cs_body_def *b, double t, const double x[3], double
 /* Velocity at time t of the body material point at world position x. */
 void cs_body_def_velocity(const cs_body_def *b, double t, const double x[3], double v[3]);
 
-/* A world box at time t holding every point where the body's phi < 0.
- * False for an unbounded body (a plane, or phi_fn without phi_bounded). */
+/* A world box at time t holding every point where the body's phi < offset
+ * (the region where it collides). False for an unbounded body (a plane, or
+ * phi_fn without phi_bounded). */
 bool cs_body_def_bounds(const cs_body_def *b, double t, double lo[3], double hi[3]);
 
 /* ---------------------------------------------------------------- cloth */
@@ -262,6 +268,10 @@ typedef enum cs_stage {
 } cs_stage;
 
 const char *cs_stage_name(cs_stage stage);
+/* The memory a run of this many particles will need at its peak, bytes (an
+ * estimate from measurements, with a margin), so that a scene too large
+ * for the machine is refused before anything is allocated. */
+double cs_sim_estimate_bytes(double particles, bool self_collision);
 const char *cs_stage_description(cs_stage stage);
 
 typedef struct cs_plan {
@@ -307,7 +317,22 @@ typedef struct cs_frame_stats {
 
 typedef struct cs_sim cs_sim;
 
-/* Creates the simulation; on failure returns NULL and writes why into err. */
+/* Limits shared by every way a scene can ask for frames and steps: a frame
+ * index fits an int, and a step so small that one frame needs more steps
+ * than this is a mistake (time.dt of 1e-12, a stiffness of 1e308), refused
+ * at creation rather than run for ever. */
+#define CS_MAX_FRAMES 100000000
+#define CS_MAX_STEPS_PER_FRAME 10000000
+
+/* Creates the simulation: CS_OK and *out, or CS_ERR_INVALID (a definition
+ * that cannot run, such as a step so small a frame would need more than
+ * CS_MAX_STEPS_PER_FRAME) or CS_ERR_NOMEM, with why in err. A fixed step
+ * above cs_sim_stable_dt is allowed: that limit ignores damping, which the
+ * solve treats implicitly and which lets Table 1's cloth run stably at many
+ * times it (40 times on an 8 x 8 hanging sheet); callers should warn, and
+ * cs_sim_runaway reports a step that does blow up. */
+int cs_sim_create_checked(const cs_sim_def *def, cs_sim **out, char *err, size_t errlen);
+/* The same; on failure returns NULL and writes why into err. */
 cs_sim *cs_sim_create(const cs_sim_def *def, char *err, size_t errlen);
 void cs_sim_destroy(cs_sim *sim);
 
@@ -316,6 +341,11 @@ void cs_sim_destroy(cs_sim *sim);
  * particle's position and velocity (other ranks their own and their
  * ghosts'), and the frame's counters summed over ranks. */
 int cs_sim_advance_frame(cs_sim *sim, cs_frame_stats *stats);
+
+/* After cs_sim_advance_frame returned CS_ERR_UNSTABLE: the stage that first
+ * saw it, the speed seen (infinity for NaN) and the bound it passed (see
+ * sim/runaway.c for what the bound allows); false when none was seen. */
+bool cs_sim_runaway(const cs_sim *sim, const char **stage, double *speed, double *limit);
 
 /* Rank 0's value, on every rank (a collective): how the ranks agree to go
  * on or stop after rank 0 has written a frame. */
@@ -374,9 +404,10 @@ const cs_comm_stats *cs_sim_rank_comm(const cs_sim *sim);
 /* Bytes the simulation allocated for a stage's own data (0 if absent). */
 size_t cs_sim_stage_bytes(const cs_sim *sim, cs_stage stage);
 
-/* How deep the deepest free cloth vertex is inside a body now: the largest
- * -phi over free vertices and bodies, 0 when none is inside (or body
- * collisions are off). */
+/* How deep the cloth's surface is inside a body now (its true surface, not
+ * the collision offset): the largest -phi over free vertices and the
+ * centroids and edge midpoints of triangles with a free vertex, 0 when none
+ * is inside (or body collisions are off), -1 without memory to look. */
 double cs_sim_body_penetration(const cs_sim *sim);
 
 /* ---------------------------------------------------------- tessellation */

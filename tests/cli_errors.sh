@@ -81,6 +81,18 @@ run 2 run tiny.yaml --set self_collision.scheme=sometimes
 err_has 'fixed, rewind'
 [ ! -e out ] || fail "a refused scene wrote output"
 
+# --- a list as a key is YAML but not a scene key (libcyaml said "Internal error")
+cat >complex_key.yaml <<'EOF'
+cloths: [{grid: {size: [1, 1], resolution: [4, 4]}}]
+? [a, b]
+: 3
+EOF
+run 2 run complex_key.yaml --plan
+err_has '^clothsim: complex_key.yaml:2: a key must be a plain name \(got a list\)'
+# --- a band of 1e308 voxels is the band's fault, not the voxel size's
+run 2 run tiny.yaml --set 'bodies=[{shape: mesh, mesh: {file: '"$2"'/assets/stanford-bunny.obj}, band: 1e308}]' --plan
+err_has 'bodies\[0\].band: must be in \[1, 1000\] \(got 1e308\)'
+
 # --- output that cannot be written: status 4, the message names the path
 : >not_a_dir
 run 4 run tiny.yaml -q -o not_a_dir/sub

@@ -258,6 +258,65 @@ static void test_penetration(void **state)
     cs_trimesh_destroy(pts);
 }
 
+/* The surface between vertices counts: one large triangle over a unit ball
+ * with every vertex 2 m from the centre and its centroid 5 cm inside. */
+static void test_penetration_between_vertices(void **state)
+{
+    (void)state;
+    cs_body_def ball = body(CS_BODY_SPHERE, 0, 0, 0);
+    ball.radius = 1;
+    cs_trimesh *tri = cs_trimesh_create(3, 1);
+    double x[9] = {-2, 0.95, -1.1547, 2, 0.95, -1.1547, 0, 0.95, 2.3094};
+    memcpy(tri->x, x, sizeof x);
+    tri->tri[0] = 0, tri->tri[1] = 1, tri->tri[2] = 2;
+    cs_cloth_def cloth = {.name = "t", .mesh = tri, .material = cs_default_cloth_material()};
+    cs_sim_def def = cs_default_sim_def();
+    def.cloths = &cloth;
+    def.ncloths = 1;
+    def.bodies = &ball;
+    def.nbodies = 1;
+    cs_sim *sim = cs_sim_create(&def, NULL, 0);
+    assert_non_null(sim);
+    assert_true(fabs(cs_sim_body_penetration(sim) - 0.05) < 1e-4);
+    cs_sim_destroy(sim);
+    cs_trimesh_destroy(tri);
+}
+
+/* bodies[].collision_offset: a particle dropped on the ground comes to rest
+ * the offset above it, and the penetration report still measures against
+ * the true surface (0: nothing is inside). */
+static void test_collision_offset(void **state)
+{
+    (void)state;
+    cs_body_def ground = body(CS_BODY_PLANE, 0, 0, 0);
+    ground.offset = 0.02;
+    cs_trimesh *pt = cs_trimesh_create(1, 0);
+    pt->x[1] = 0.1;
+    cs_cloth_def cloth = {.name = "p", .mesh = pt, .material = cs_default_cloth_material()};
+    cs_sim_def def = cs_default_sim_def();
+    def.cloths = &cloth;
+    def.ncloths = 1;
+    def.bodies = &ground;
+    def.nbodies = 1;
+    def.fps = 24;
+    cs_sim *sim = cs_sim_create(&def, NULL, 0);
+    assert_non_null(sim);
+    cs_frame_stats st;
+    for (int f = 0; f < 12; f++) /* 0.5 s: it lands after 0.13 s */
+        assert_int_equal(cs_sim_advance_frame(sim, &st), CS_OK);
+    double y = cs_sim_positions(sim)[1];
+    assert_true(fabs(y - 0.02) < 1e-3);
+    assert_true(cs_sim_body_penetration(sim) == 0);
+    cs_sim_destroy(sim);
+    ground.offset = 0;
+    sim = cs_sim_create(&def, NULL, 0);
+    for (int f = 0; f < 12; f++)
+        assert_int_equal(cs_sim_advance_frame(sim, &st), CS_OK);
+    assert_true(fabs(cs_sim_positions(sim)[1]) < 1e-3);
+    cs_sim_destroy(sim);
+    cs_trimesh_destroy(pt);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -265,6 +324,8 @@ int main(void)
         cmocka_unit_test(test_same_physics_as_every_body_per_point),
         cmocka_unit_test(test_far_bodies_cost_no_queries),
         cmocka_unit_test(test_penetration),
+        cmocka_unit_test(test_penetration_between_vertices),
+        cmocka_unit_test(test_collision_offset),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

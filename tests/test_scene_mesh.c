@@ -344,7 +344,7 @@ static void test_errors(void **state)
     snprintf(text, sizeof text, "%s    voxel_size: 1e-5\n", ico);
     expect_error_prefix(text, "scenes/a.yaml:6: bodies[0].voxel_size: would need about ");
     snprintf(text, sizeof text, "%s    band: 0.5\n", ico);
-    expect_error(text, 0, NULL, "scenes/a.yaml:6: bodies[0].band: must be >= 1 (got 0.5)");
+    expect_error(text, 0, NULL, "scenes/a.yaml:6: bodies[0].band: must be in [1, 1000] (got 0.5)");
     snprintf(text, sizeof text, "%s    interior: hollow\n", ico);
     expect_error(text, 0, NULL,
                  "scenes/a.yaml:6: bodies[0].interior: expected one of auto, fill, band (got "

@@ -9,6 +9,7 @@
 #include <cmocka.h>
 
 #include <math.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -481,6 +482,113 @@ static void test_automatic_dt_is_stable_across_resolutions(void **state)
     }
 }
 
+/* A hanging cloth like the one above (8 x 8, pinned at two corners). */
+static cs_sim *hanging_cloth(cs_trimesh **mesh, double dt, double stiffness, char *err,
+                             size_t errlen, int *status)
+{
+    double size[2] = {1, 1}, q[4] = {1, 0, 0, 0}, c[3] = {0, 0, 0};
+    int res[2] = {8, 8};
+    static int corners[2] = {0, 8};
+    static cs_vertex_script pin;
+    pin = (cs_vertex_script){2, corners, cs_motion_static()};
+    *mesh = cs_trimesh_create_grid(size, res, q, c);
+    static cs_cloth_def cloth;
+    cloth = (cs_cloth_def){.name = "c", .mesh = *mesh, .material = cs_default_cloth_material(),
+                           .nscripts = 1, .scripts = &pin};
+    if (stiffness > 0)
+        cloth.material.edge_stiffness = stiffness;
+    cs_sim_def def = cs_default_sim_def();
+    def.ncloths = 1;
+    def.cloths = &cloth;
+    def.fps = 60;
+    def.dt = dt;
+    cs_sim *sim = NULL;
+    *status = cs_sim_create_checked(&def, &sim, err, errlen);
+    return sim;
+}
+
+/* Steps the scene cannot take are refused at creation with the reason, not
+ * run: a step so small that a frame needs more than CS_MAX_STEPS_PER_FRAME
+ * of them (it used to overflow an int and become one step per frame), and a
+ * stiffness that makes the stability limit that small. A fixed step above
+ * the undamped limit is allowed (damping keeps it stable, see below). */
+static void test_impossible_steps_are_refused(void **state)
+{
+    (void)state;
+    cs_trimesh *mesh;
+    char err[512];
+    int status;
+    cs_sim *sim = hanging_cloth(&mesh, 0, 0, err, sizeof err, &status);
+    assert_int_equal(status, CS_OK);
+    double limit = cs_sim_stable_dt(sim);
+    cs_sim_destroy(sim);
+    cs_trimesh_destroy(mesh);
+
+    sim = hanging_cloth(&mesh, 1.01 * limit, 0, err, sizeof err, &status);
+    assert_int_equal(status, CS_OK);
+    assert_true(cs_sim_dt(sim) == 1.01 * limit || cs_sim_dt(sim) < 1.01 * limit);
+    cs_sim_destroy(sim);
+    cs_trimesh_destroy(mesh);
+
+    sim = hanging_cloth(&mesh, 1e-12, 0, err, sizeof err, &status);
+    assert_null(sim);
+    assert_int_equal(status, CS_ERR_INVALID);
+    assert_non_null(strstr(err, "time.dt is too small"));
+    cs_trimesh_destroy(mesh);
+
+    sim = hanging_cloth(&mesh, 0, 1e308, err, sizeof err, &status);
+    assert_null(sim);
+    assert_int_equal(status, CS_ERR_INVALID);
+    assert_non_null(strstr(err, "stiffness and mass"));
+    cs_trimesh_destroy(mesh);
+}
+
+/* Far past the stability limit the explicit elastic forces grow
+ * geometrically: 91 times the undamped limit (the one step per frame that
+ * time.dt: 1e-12 used to become) must be caught early (the issue saw the
+ * drape reach 1.4e6 m/s and exit "ok"), named with the stage that saw it;
+ * the same cloth at the automatic step runs 60 frames without a false
+ * alarm. (Up to 40 times the limit this damped cloth stays stable.) */
+static void test_runaway_is_detected_with_its_stage(void **state)
+{
+    (void)state;
+    cs_trimesh *mesh;
+    char err[512];
+    int status;
+    cs_sim *sim = hanging_cloth(&mesh, 0, 0, err, sizeof err, &status);
+    assert_int_equal(status, CS_OK);
+    double dt = 91 * cs_sim_stable_dt(sim);
+    int steps = 0, rc = CS_OK;
+    while (rc == CS_OK && steps < 200) {
+        rc = cs_sim_step(sim, dt);
+        steps++;
+    }
+    assert_int_equal(rc, CS_ERR_UNSTABLE);
+    const char *stage = NULL;
+    double speed = 0, limit = 0;
+    assert_true(cs_sim_runaway(sim, &stage, &speed, &limit));
+    assert_true(strcmp(stage, "velocity_half") == 0 || strcmp(stage, "velocity_full") == 0);
+    assert_true(speed > limit);
+    /* caught early: a limit of hundreds of m/s, not after the state is NaN */
+    assert_true(isfinite(speed));
+    assert_true(limit < 1000);
+    assert_true(steps < 40);
+    cs_sim_destroy(sim);
+    cs_trimesh_destroy(mesh);
+
+    sim = hanging_cloth(&mesh, 0, 0, err, sizeof err, &status);
+    cs_frame_stats st;
+    for (int f = 0; f < 60; f++) {
+        if (cs_sim_advance_frame(sim, &st) != CS_OK) {
+            cs_sim_runaway(sim, &stage, &speed, &limit);
+            fail_msg("frame %d: %s %g > %g", f, stage, speed, limit);
+        }
+    }
+    assert_false(cs_sim_runaway(sim, NULL, NULL, NULL));
+    cs_sim_destroy(sim);
+    cs_trimesh_destroy(mesh);
+}
+
 
 /* Linear normal drag (Section 8): a horizontal sheet of areal density rho
  * falling in still air feels -c A (v.n) n per vertex and m = rho A, so every
@@ -660,6 +768,8 @@ int main(void)
         cmocka_unit_test(test_keyframe_motion),
         cmocka_unit_test(test_plan_omits_absent_stages),
         cmocka_unit_test(test_automatic_dt_is_stable_across_resolutions),
+        cmocka_unit_test(test_impossible_steps_are_refused),
+        cmocka_unit_test(test_runaway_is_detected_with_its_stage),
         cmocka_unit_test(test_wind_drag_terminal_velocity),
         cmocka_unit_test(test_moving_body_drags_particle),
         cmocka_unit_test(test_scripted_vertices_follow_keys),

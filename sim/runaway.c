@@ -1,0 +1,154 @@
+/* runaway.c: instability detection (issue 12).
+ *
+ * A blow-up of the explicit elastic forces, a solve gone astray or a
+ * collision response that adds energy all show as cloth moving far faster
+ * than anything in the scene can drive it. The bound is history-free (a
+ * function of the scene and the time only, the same on every rank and after
+ * a resume):
+ *
+ *   limit(t) = 10 (v0 + |g| t + body(t) + script(t) + |wind|) + c / 4 + 1 m/s
+ *
+ * v0 the fastest initial velocity; |g| t what gravity can give since the
+ * start; body(t) and script(t) the fastest surface point of a moving body
+ * or a scripted vertex set now (|v| + |w| r over its extent); c the fastest
+ * elastic wave, sqrt(E L0 / m) over the edge springs: a stretch of strain e
+ * released sends its ends back at e c, and cloth that was stretched by a
+ * quarter is far beyond Table 1's (stiff cloth, c of hundreds of m/s). The factor 10 leaves room for
+ * whips and snaps (a cloth corner can outrun what drives it); a real
+ * blow-up grows geometrically and passes any such bound within a few steps.
+ * An unbounded body that rotates (a spinning plane) has no finite surface
+ * speed: the limit is then infinite and only NaN is caught.
+ *
+ * Each stage that produces a velocity checks its result on the owned free
+ * particles (no message); the end of the step's reduction, which every step
+ * already makes for NaN, carries the verdict and the first stage. */
+#include "sim/internal.h"
+#include "sim/vec3.h"
+
+#include <math.h>
+
+enum { SPEED_FACTOR = 10 };
+static const double SPEED_FLOOR = 1.0; /* m/s: still scenes */
+
+void cs_runaway_init(cs_sim *sim)
+{
+    double v0 = 0, wave = 0;
+    for (int i = 0; i < sim->n; i++)
+        v0 = fmax(v0, cs_norm(sim->v + 3 * i));
+    const cs_springs *sp = &sim->springs;
+    for (int s = 0; s < sp->nedge; s++) { /* sqrt(E L0 / m): a chain's wave speed */
+        double m = fmin(sim->mass[sp->ends[2 * s]], sim->mass[sp->ends[2 * s + 1]]);
+        wave = fmax(wave, sqrt(sp->stiffness[s] * sp->rest_length[s] / m));
+    }
+    sim->runaway.initial_speed = v0;
+    sim->runaway.wave_speed = wave;
+    /* the extent of each script's vertices about its frame */
+    for (int s = 0; s < sim->nscripts; s++) {
+        cs_script_state *sc = sim->scripts + s;
+        sc->radius = 0;
+        for (int j = 0; j < sc->nvertices; j++)
+            sc->radius = fmax(sc->radius, cs_norm(sc->local + 3 * j));
+    }
+    sim->runaway.stage = -1;
+}
+
+/* The fastest point within r of a rigid motion's centre at time t. */
+static double motion_speed(const cs_motion *m, double t, double r)
+{
+    double c[3], vel[3], w[3];
+    cs_motion_pose(m, t, NULL, c, vel, w);
+    return cs_norm(vel) + cs_norm(w) * r;
+}
+
+double cs_runaway_limit(const cs_sim *sim, double t)
+{
+    double drive = sim->runaway.initial_speed + cs_norm(sim->def.gravity) * fabs(t);
+    if (sim->def.wind_enabled)
+        drive += cs_norm(sim->def.wind.velocity);
+    for (int s = 0; s < sim->nscripts; s++)
+        drive += motion_speed(&sim->scripts[s].motion, t, sim->scripts[s].radius);
+    for (int b = 0; b < sim->nbodies; b++) {
+        const cs_body_def *body = sim->bodies + b;
+        double c[3], w[3], lo[3], hi[3], r = 0;
+        cs_motion_pose(&body->motion, t, NULL, c, NULL, w);
+        if (cs_norm(w) > 0) {
+            if (!cs_body_def_bounds(body, t, lo, hi))
+                return INFINITY;
+            for (int k = 0; k < 8; k++) { /* the box corner farthest from c */
+                double corner[3] = {k & 1 ? hi[0] : lo[0], k & 2 ? hi[1] : lo[1],
+                                    k & 4 ? hi[2] : lo[2]};
+                double d[3];
+                cs_sub(corner, c, d);
+                r = fmax(r, cs_norm(d));
+            }
+        }
+        drive += motion_speed(&body->motion, t, r);
+    }
+    return SPEED_FACTOR * drive + 0.25 * sim->runaway.wave_speed + SPEED_FLOOR;
+}
+
+void cs_runaway_begin_step(cs_sim *sim, double t1)
+{
+    double limit = cs_runaway_limit(sim, t1);
+    sim->runaway.limit = limit;
+    sim->runaway.limit2 = limit * limit;
+}
+
+void cs_runaway_check(cs_sim *sim, const double *v, cs_stage stage)
+{
+    double worst = 0;
+    bool bad = false;
+    CS_FOR_OWNED(sim->par, i) {
+        if (!sim->is_free[i])
+            continue;
+        const double *vi = v + 3 * i;
+        double s2 = vi[0] * vi[0] + vi[1] * vi[1] + vi[2] * vi[2];
+        if (!(s2 <= sim->runaway.limit2)) { /* NaN too */
+            bad = true;
+            if (!(s2 <= worst)) /* keeps a NaN */
+                worst = s2;
+        }
+    }
+    if (bad && sim->runaway.stage < 0) {
+        sim->runaway.stage = stage;
+        sim->runaway.speed = sqrt(worst);
+    }
+}
+
+bool cs_runaway_end_step(cs_sim *sim)
+{
+    /* one reduction: the earliest stage (as STAGE_COUNT - stage, so the
+     * maximum wins), the speed seen there, and NaN anywhere in x or v */
+    double verdict[2] = {0, 0};
+    if (sim->runaway.stage >= 0) {
+        verdict[0] = CS_STAGE_COUNT - sim->runaway.stage;
+        verdict[1] = isnan(sim->runaway.speed) ? INFINITY : sim->runaway.speed;
+    }
+    CS_FOR_OWNED(sim->par, i)
+        for (int d = 0; d < 3; d++)
+            if (!isfinite(sim->x[3 * i + d]) || !isfinite(sim->v[3 * i + d])) {
+                if (verdict[0] == 0)
+                    verdict[0] = CS_STAGE_COUNT - CS_STAGE_VELOCITY_FULL;
+                verdict[1] = INFINITY;
+            }
+    cs_par_begin(sim->par, CS_STAGE_VELOCITY_FULL); /* B.6's result checked */
+    cs_par_max(sim->par, verdict, 2);
+    if (verdict[0] == 0)
+        return true;
+    sim->runaway.stage = CS_STAGE_COUNT - (int)verdict[0];
+    sim->runaway.speed = verdict[1];
+    return false;
+}
+
+bool cs_sim_runaway(const cs_sim *sim, const char **stage, double *speed, double *limit)
+{
+    if (sim->runaway.stage < 0)
+        return false;
+    if (stage)
+        *stage = cs_stage_name((cs_stage)sim->runaway.stage);
+    if (speed)
+        *speed = sim->runaway.speed;
+    if (limit)
+        *limit = sim->runaway.limit;
+    return true;
+}
