@@ -1,10 +1,15 @@
 /* fsutil.c: file-system helpers shared by the command's subcommands. */
+#define _GNU_SOURCE /* syncfs */
 #include "app/fsutil.h"
 
 #include <errno.h>
+#include <fcntl.h>
+#include <stdbool.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
+#include <unistd.h>
 
 int cs_make_dirs(const char *path)
 {
@@ -36,4 +41,119 @@ int cs_make_dirs(const char *path)
     }
     free(p);
     return rc;
+}
+
+char *cs_path_join(const char *a, const char *b)
+{
+    size_t la = strlen(a), lb = strlen(b);
+    char *p = malloc(la + lb + 2);
+    if (p) {
+        memcpy(p, a, la);
+        p[la] = '/';
+        memcpy(p + la + 1, b, lb + 1);
+    }
+    return p;
+}
+
+char *cs_path_tmp(const char *path)
+{
+    size_t len = strlen(path);
+    char *tmp = malloc(len + 5);
+    if (tmp) {
+        memcpy(tmp, path, len);
+        memcpy(tmp + len, ".tmp", 5);
+    }
+    return tmp;
+}
+
+int cs_file_commit(FILE *fp, const char *tmp, const char *path, char *err, size_t errlen)
+{
+    errno = 0;
+    int failed = fflush(fp) != 0 || ferror(fp);
+    int saved = errno;
+    if (fclose(fp) != 0 && !failed) {
+        failed = 1;
+        saved = errno;
+    }
+    if (failed) {
+        snprintf(err, errlen, "cannot write %s: %s", path,
+                 strerror(saved ? saved : EIO));
+        remove(tmp);
+        return -1;
+    }
+    if (rename(tmp, path) != 0) {
+        snprintf(err, errlen, "cannot rename %s to %s: %s", tmp, path, strerror(errno));
+        remove(tmp);
+        return -1;
+    }
+    return 0;
+}
+
+int cs_file_write_atomic(const char *path, const void *data, size_t len, char *err,
+                         size_t errlen)
+{
+    char *tmp = cs_path_tmp(path);
+    if (!tmp) {
+        snprintf(err, errlen, "cannot write %s: out of memory", path);
+        return -1;
+    }
+    int rc = -1;
+    errno = 0;
+    FILE *fp = fopen(tmp, "wb");
+    if (!fp) {
+        snprintf(err, errlen, "cannot write %s: %s", path, strerror(errno));
+    } else if (fwrite(data, 1, len, fp) != len) {
+        snprintf(err, errlen, "cannot write %s: %s", path, strerror(errno ? errno : EIO));
+        fclose(fp);
+        remove(tmp);
+    } else {
+        rc = cs_file_commit(fp, tmp, path, err, errlen);
+    }
+    free(tmp);
+    return rc;
+}
+
+char *cs_file_read_all(const char *path, size_t *len)
+{
+    FILE *fp = fopen(path, "rb");
+    if (!fp)
+        return NULL;
+    size_t cap = 4096, n = 0;
+    char *buf = malloc(cap);
+    while (buf) {
+        n += fread(buf + n, 1, cap - 1 - n, fp);
+        if (ferror(fp) || feof(fp))
+            break;
+        char *grown = realloc(buf, 2 * cap);
+        if (!grown) {
+            free(buf);
+            errno = ENOMEM;
+        }
+        buf = grown;
+        cap *= 2;
+    }
+    bool failed = !buf || ferror(fp);
+    int saved = errno;
+    fclose(fp);
+    if (failed) {
+        free(buf);
+        errno = saved ? saved : EIO;
+        return NULL;
+    }
+    buf[n] = '\0';
+    *len = n;
+    return buf;
+}
+
+int cs_dir_sync(const char *dir, char *err, size_t errlen)
+{
+    int fd = open(dir, O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+    if (fd < 0 || syncfs(fd) != 0) {
+        snprintf(err, errlen, "cannot write %s to the disk: %s", dir, strerror(errno));
+        if (fd >= 0)
+            close(fd);
+        return -1;
+    }
+    close(fd);
+    return 0;
 }

@@ -11,13 +11,14 @@
 #include "app/fsutil.h"
 #include "app/run.h"
 
+#include "app/checkpoint.h"
+#include "app/outdir.h"
 #include "app/progress.h"
 #include "app/scene_render.h"
 #include "app/summary.h"
 #include "import/import.h"
 #include "sim/sim.h"
 
-#include <dirent.h>
 #include <errno.h>
 #include <getopt.h>
 #include <math.h>
@@ -47,6 +48,7 @@ typedef struct run_options {
     char *frames_override;    /* owned "time.frames=N" */
     bool plan_only;
     bool quiet;
+    bool resume;              /* --resume: continue the run in DIR */
     const char *render;       /* --render ENGINE, --size, --samples; NULL: none */
     const char *render_size, *render_samples;
     int threads;              /* --threads N; 0: one per core (see cs_parallel_set_threads) */
@@ -63,8 +65,16 @@ void cs_run_help(FILE *out)
         "\n"
         "options:\n"
         "  -o, --output DIR     write into DIR (default: out/<scene name>): frames as\n"
-        "                       DIR/frames/frame_0000.<ext>, ... and DIR/summary.json;\n"
-        "                       frame files of an earlier run in DIR/frames are removed\n"
+        "                       DIR/frames/frame_0000.<ext>, ..., DIR/summary.json,\n"
+        "                       DIR/frames.jsonl (a record per frame) and DIR/state.h5\n"
+        "                       (what --resume needs); the frames, records and state\n"
+        "                       of an earlier run in DIR are removed; one run at a time\n"
+        "                       (another run writing into DIR is refused, exit 4)\n"
+        "      --resume         continue the run in DIR from its last frame (after a\n"
+        "                       kill, a crash or --frames K): the same scene and --set\n"
+        "                       overrides are required (--frames may grow), and the\n"
+        "                       frames are the bits of a run never interrupted (same\n"
+        "                       rank count)\n"
         "      --set KEY=VALUE  override a scene setting; KEY is a dotted path, VALUE is\n"
         "                       YAML, e.g. --set time.frames=10 --set gravity=[0,-9.8,0]\n"
         "                       --set cloths.0.material.node_mass=2e-6; repeatable, a\n"
@@ -87,15 +97,21 @@ void cs_run_help(FILE *out)
         "  -q, --quiet          no progress display\n"
         "  -h, --help           show this help\n"
         "\n"
-        "DIR/summary.json is rewritten after every frame; its \"status\" is \"running\"\n"
-        "until the run ends as \"ok\", \"unstable\", \"interrupted\" or \"failed\".\n"
+        "While the run goes, each frame appends its record to DIR/frames.jsonl and\n"
+        "DIR/summary.json is rewritten at most once a second without the records; at\n"
+        "the end it is written whole. Its \"status\" is \"running\" until the run\n"
+        "ends as \"ok\", \"unstable\", \"interrupted\" or \"failed\" (a run killed\n"
+        "outright stays \"running\": --resume continues it).\n"
         "\n"
         "exit status:\n"
         "  0    every frame written\n"
         "  1    bad command line\n"
-        "  2    the scene is invalid (message: FILE:LINE: KEY: what was expected)\n"
+        "  2    the scene is invalid (message: FILE:LINE: KEY: what was expected)\n"        "       or --resume refused: the scene, an override or the format changed\n"
+        "       (the difference named), or DIR holds no state to resume from\n"
         "  3    the simulation became unstable; the frames before are kept\n"
-        "  4    output could not be written, or memory ran out\n"
+        "  4    output could not be written (the message names the file and why),\n"
+        "       DIR is in use by another run, or memory ran out; the frames before\n"
+        "       are kept\n"
         "  130  interrupted by SIGINT or SIGTERM; the frames before are kept\n",
         out);
 }
@@ -105,12 +121,12 @@ static void usage_error(const char *fmt, const char *arg)
     fprintf(stderr, "clothsim run: ");
     fprintf(stderr, fmt, arg);
     fprintf(stderr, "\nusage: clothsim run SCENE [-o DIR] [--set KEY=VALUE]... [--format ply|obj|glb]\n"
-                    "                    [--frames N] [--threads N] [--plan] [--quiet]\n"
+                    "                    [--frames N] [--threads N] [--plan] [--resume] [--quiet]\n"
                     "'clothsim run --help' explains every option.\n");
 }
 
 enum { OPT_SET = 256, OPT_FORMAT, OPT_FRAMES, OPT_PLAN, OPT_RENDER, OPT_SIZE, OPT_SAMPLES,
-       OPT_THREADS };
+       OPT_THREADS, OPT_RESUME };
 
 /* Whether text is a whole number in [lo, hi] (stored in *out if given). */
 static bool whole_number(const char *text, long lo, long hi, int *out)
@@ -138,6 +154,7 @@ static int parse_options(int argc, char **argv, run_options *o)
         {"size", required_argument, NULL, OPT_SIZE},
         {"samples", required_argument, NULL, OPT_SAMPLES},
         {"threads", required_argument, NULL, OPT_THREADS},
+        {"resume", no_argument, NULL, OPT_RESUME},
         {"quiet", no_argument, NULL, 'q'},
         {"help", no_argument, NULL, 'h'},
         {NULL, 0, NULL, 0},
@@ -178,8 +195,8 @@ static int parse_options(int argc, char **argv, run_options *o)
             o->format = optarg;
             break;
         case OPT_FRAMES:
-            if (!whole_number(optarg, 0, 100000000, NULL)) {
-                usage_error("--frames: '%s' is not a whole number of frames", optarg);
+            if (!whole_number(optarg, 0, CS_MAX_FRAMES, NULL)) {
+                usage_error("--frames: '%s' is not a whole number from 0 to 100000000", optarg);
                 return CS_EXIT_USAGE;
             }
             frames = optarg;
@@ -192,6 +209,9 @@ static int parse_options(int argc, char **argv, run_options *o)
             break;
         case OPT_PLAN:
             o->plan_only = true;
+            break;
+        case OPT_RESUME:
+            o->resume = true;
             break;
         case OPT_RENDER:
             o->render = optarg;
@@ -280,76 +300,9 @@ static void install_signal_handlers(void)
     sa.sa_flags = SA_RESETHAND | SA_RESTART;
     sigaction(SIGINT, &sa, NULL);
     sigaction(SIGTERM, &sa, NULL);
-}
-
-/* "frame_<digits>.<ply|obj|glb>" with an optional ".tmp". */
-static bool is_frame_file(const char *name)
-{
-    if (strncmp(name, "frame_", 6) != 0)
-        return false;
-    const char *s = name + 6;
-    if (*s < '0' || *s > '9')
-        return false;
-    while (*s >= '0' && *s <= '9')
-        s++;
-    if (*s++ != '.')
-        return false;
-    cs_mesh_format f;
-    char ext[4];
-    if (strlen(s) < 3)
-        return false;
-    memcpy(ext, s, 3);
-    ext[3] = '\0';
-    if (!cs_mesh_format_from_name(ext, &f))
-        return false;
-    return s[3] == '\0' || strcmp(s + 3, ".tmp") == 0;
-}
-
-/* Frames of an earlier run would mix with this one's; remove them. */
-static int remove_old_frames(const char *dir, char *err, size_t errlen)
-{
-    DIR *d = opendir(dir);
-    if (!d) {
-        snprintf(err, errlen, "cannot read %s: %s", dir, strerror(errno));
-        return -1;
-    }
-    int rc = 0;
-    struct dirent *e;
-    while ((e = readdir(d)) != NULL) {
-        if (!is_frame_file(e->d_name))
-            continue;
-        char path[4096];
-        snprintf(path, sizeof path, "%s/%s", dir, e->d_name);
-        if (unlink(path) != 0) {
-            snprintf(err, errlen, "cannot remove the old frame %s/%s: %s", dir, e->d_name,
-                     strerror(errno));
-            rc = -1;
-            break;
-        }
-    }
-    closedir(d);
-    return rc;
-}
-
-/* out/<scene name>, the name made safe for a path. */
-static char *default_out_dir(const char *scene_name)
-{
-    const char *name = scene_name && *scene_name ? scene_name : "scene";
-    size_t len = strlen(name);
-    char *dir = malloc(len + 5);
-    if (!dir)
-        return NULL;
-    memcpy(dir, "out/", 4);
-    for (size_t i = 0; i < len; i++) {
-        char ch = name[i];
-        bool safe = (ch >= 'a' && ch <= 'z') || (ch >= 'A' && ch <= 'Z') ||
-                    (ch >= '0' && ch <= '9') || ch == '-' || ch == '_' || ch == '.';
-        dir[4 + i] = safe ? ch : '_';
-    }
-    dir[4 + len] = '\0';
-    if (strcmp(dir, "out/.") == 0 || strcmp(dir, "out/..") == 0)
-        strcpy(dir, "out/scene");
-    return dir;
+    /* a file-size limit (ulimit -f) then fails the write (EFBIG), which is
+     * reported with exit 4, instead of killing the run mid-file */
+    signal(SIGXFSZ, SIG_IGN);
 }
 
 /* ----------------------------------------------------------------- output */
@@ -358,9 +311,12 @@ typedef struct run_state {
     const cs_scene *scene;
     cs_sim *sim;
     cs_mesh_format format;
-    char *out_dir;
-    char *frames_dir;
-    char *summary_path;
+    cs_outdir out;           /* the folder, its paths and its lock */
+    const char *frames_dir;  /* out's, for the messages */
+    const char *summary_path;
+    cs_run_identity id;      /* what a resumed run must be made from */
+    int first_frame;         /* frame 0, or the frame --resume continues after */
+    double summary_at;       /* now_seconds() of the last summary.json written */
     cs_mesh_view *views;     /* one per cloth */
     cs_run_render *render;   /* --render: an image per frame too */
     cs_summary summary;
@@ -392,23 +348,26 @@ static int write_frame(run_state *r, int frame, char *err, size_t errlen)
     return rc;
 }
 
+/* While the status is "running" summary.json leaves the frame records to
+ * frames.jsonl (a constant cost per frame); once it is final, whole. */
 static int write_summary(run_state *r, char *err, size_t errlen)
 {
-    r->summary.total_seconds = now_seconds() - r->start;
+    r->summary.total_seconds = r->summary.base_seconds + now_seconds() - r->start;
     cs_summary_take_timing(&r->summary, r->sim);
-    return cs_summary_write(&r->summary, r->summary_path, err, errlen);
+    bool final = strcmp(r->summary.status, "running") != 0;
+    r->summary_at = now_seconds();
+    return cs_summary_write(&r->summary, r->summary_path, final, err, errlen);
 }
 
-static char *join_path(const char *a, const char *b)
+/* Rank 0, after frame's file (and record): the state --resume continues
+ * from (cs_sim_state_gather came first, on every rank). */
+static int save_state(run_state *r, int frame, const char *hash, char *err, size_t errlen)
 {
-    size_t la = strlen(a), lb = strlen(b);
-    char *p = malloc(la + lb + 2);
-    if (p) {
-        memcpy(p, a, la);
-        p[la] = '/';
-        memcpy(p + la + 1, b, lb + 1);
-    }
-    return p;
+    double t0 = now_seconds();
+    int rc = cs_outdir_save_state(&r->out, &r->id, frame, hash, r->sim, &r->summary, err,
+                                  errlen);
+    r->summary.output_seconds += now_seconds() - t0;
+    return rc;
 }
 
 /* ------------------------------------------------------------------- plan */
@@ -458,9 +417,26 @@ static void frames_kept(int written, char *buf, size_t len)
         snprintf(buf, len, "no frame is");
 }
 
-/* Rank 0, after a frame simulated: the frame file, its record and the
- * summary. Returns CS_EXIT_OK to go on, a status to stop with the report,
- * or minus a status to stop without it. */
+/* Rank 0: a write failed; says what, and which frames are kept. */
+static int output_failed(run_state *r, cs_progress *progress, const char *err, const char *what,
+                         int frame)
+{
+    cs_summary *s = &r->summary;
+    char kept[64];
+    cs_progress_finish(progress);
+    frames_kept(s->frames_written, kept, sizeof kept);
+    fprintf(stderr, "clothsim: %s\nclothsim: %s; %s kept in %s\n", err, what, kept,
+            r->frames_dir);
+    s->status = "failed";
+    s->error = what;
+    s->failed_frame = frame;
+    return CS_EXIT_OUTPUT;
+}
+
+/* Rank 0, after a frame simulated: the frame file, its record, the state
+ * to resume from and the summary, in that order (a state is never ahead of
+ * its frame and record). Returns CS_EXIT_OK to go on, a status to stop
+ * with the report, or minus a status to stop without it. */
 static int record_frame(run_state *r, int frame, const cs_frame_stats *stats, double seconds,
                         cs_progress *progress, double sim_start)
 {
@@ -479,22 +455,19 @@ static int record_frame(run_state *r, int frame, const cs_frame_stats *stats, do
                                 ? cs_sim_body_penetration(r->sim)
                                 : -1,
     };
-    if (write_frame(r, frame, err, sizeof err) != CS_IMPORT_OK) {
-        cs_progress_finish(progress);
-        fprintf(stderr, "clothsim: %s\n", err);
-        s->status = "failed";
-        s->error = "a frame file could not be written";
-        s->failed_frame = frame;
-        return CS_EXIT_OUTPUT;
-    }
-    if (cs_summary_add_frame(s, &rec) != 0) {
-        cs_progress_finish(progress);
-        fprintf(stderr, "clothsim: out of memory\n");
-        s->status = "failed";
-        s->error = "out of memory";
-        return CS_EXIT_OUTPUT;
-    }
-    if (write_summary(r, err, sizeof err) != 0) {
+    cs_state_hash(r->sim, rec.state_hash);
+    if (write_frame(r, frame, err, sizeof err) != CS_IMPORT_OK)
+        return output_failed(r, progress, err, "a frame file could not be written", frame);
+    if (cs_summary_add_frame(s, &rec, err, sizeof err) != 0)
+        return output_failed(r, progress, err, "the frame's record could not be written", frame);
+    if (save_state(r, frame, rec.state_hash, err, sizeof err) != 0)
+        return output_failed(r, progress, err, "the state to resume from could not be written",
+                             frame);
+    if (cs_outdir_sync(&r->out, false, err, sizeof err) != 0)
+        return output_failed(r, progress, err, "the output could not be written to the disk",
+                             frame);
+    /* while running, at most once a second: frames.jsonl has every frame */
+    if (now_seconds() - r->summary_at >= 1.0 && write_summary(r, err, sizeof err) != 0) {
         cs_progress_finish(progress);
         fprintf(stderr, "clothsim: %s\n", err);
         return -CS_EXIT_OUTPUT;
@@ -504,6 +477,23 @@ static int record_frame(run_state *r, int frame, const cs_frame_stats *stats, do
         return CS_EXIT_OK;
     s->status = "interrupted"; /* the frame is kept; nothing more is simulated */
     return CS_EXIT_INTERRUPTED;
+}
+
+/* Rank 0, before the first frame simulated: frame 0 and its state, or
+ * after --resume only the summary. Returns as record_frame does. */
+static int start_output(run_state *r, cs_progress *progress)
+{
+    char err[ERRLEN];
+    if (r->first_frame == 0 && write_frame(r, 0, err, sizeof err) != CS_IMPORT_OK)
+        return output_failed(r, progress, err, "a frame file could not be written", 0);
+    if (r->first_frame == 0 && save_state(r, 0, r->summary.initial_hash, err, sizeof err) != 0)
+        return output_failed(r, progress, err, "the state to resume from could not be written",
+                             0);
+    if (write_summary(r, err, sizeof err) != 0) {
+        fprintf(stderr, "clothsim: %s\n", err);
+        return -CS_EXIT_OUTPUT; /* stop without the report */
+    }
+    return CS_EXIT_OK;
 }
 
 /* Rank 0 writes, prints and decides; the others simulate their particles
@@ -517,37 +507,37 @@ static int simulate(run_state *r, const run_options *o)
     int status = CS_EXIT_OK;
 
     install_signal_handlers();
-    if (root) {
-        if (cs_make_dirs(r->frames_dir) != 0) {
-            fprintf(stderr, "clothsim: cannot create %s: %s\n", r->frames_dir, strerror(errno));
-            status = CS_EXIT_OUTPUT;
-        } else if (remove_old_frames(r->frames_dir, err, sizeof err) != 0) {
-            fprintf(stderr, "clothsim: %s\n", err);
-            status = CS_EXIT_OUTPUT;
-        }
-    }
+    if (root)
+        status = cs_outdir_start(&r->out, o->resume, o->quiet, &r->id, r->sim, &r->summary,
+                                 r->format, r->scene->frames, &r->first_frame);
     if ((status = cs_sim_agree(r->sim, status)) != CS_EXIT_OK)
         return status;
+    r->first_frame = cs_sim_agree(r->sim, r->first_frame);
+    if (o->resume && cs_sim_state_scatter(r->sim) != CS_OK) { /* every rank takes it */
+        if (root)
+            fprintf(stderr, "clothsim: out of memory\n");
+        return CS_EXIT_OUTPUT;
+    }
 
     cs_progress progress;
     cs_progress_init(&progress, stderr, o->quiet || !root, r->scene->frames);
 
+    cs_sim_state_gather(r->sim);
     if (root) {
         if (interrupted) {
             s->status = "interrupted";
             status = CS_EXIT_INTERRUPTED;
-        } else if (write_frame(r, 0, err, sizeof err) != CS_IMPORT_OK ||
-                   write_summary(r, err, sizeof err) != 0) {
-            fprintf(stderr, "clothsim: %s\n", err);
-            status = -CS_EXIT_OUTPUT; /* stop without the report */
+        } else {
+            status = start_output(r, &progress);
         }
     }
     if ((status = cs_sim_agree(r->sim, status)) < 0)
         return -status;
 
-    cs_progress_frame(&progress, 0, cs_sim_time(r->sim), 0.0);
+    cs_progress_frame(&progress, r->first_frame, cs_sim_time(r->sim), 0.0);
     double sim_start = now_seconds();
-    for (int frame = 1; status == CS_EXIT_OK && frame <= r->scene->frames; frame++) {
+    for (int frame = r->first_frame + 1; status == CS_EXIT_OK && frame <= r->scene->frames;
+         frame++) {
         cs_frame_stats stats;
         memset(&stats, 0, sizeof stats);
         double t0 = now_seconds();
@@ -559,13 +549,24 @@ static int simulate(run_state *r, const run_options *o)
             cs_progress_finish(&progress);
             char kept[64];
             frames_kept(s->frames_written, kept, sizeof kept);
+            static char why[192]; /* lives as long as the summary that points at it */
+            const char *stage = "?";
+            double speed = 0, limit = 0;
+            if (!cs_sim_runaway(r->sim, &stage, &speed, &limit))
+                snprintf(why, sizeof why, "NaN or runaway velocity");
+            else if (isfinite(speed))
+                snprintf(why, sizeof why,
+                         "speed %.3g m/s after stage %s, beyond the %.3g m/s the scene's "
+                         "gravity, bodies, scripts and wind can explain", speed, stage, limit);
+            else
+                snprintf(why, sizeof why, "NaN or infinite velocity after stage %s", stage);
             if (root)
                 fprintf(stderr,
                         "clothsim: the simulation became unstable in frame %d (t=%.4g s): "
-                        "NaN or runaway velocity; %s in %s\n",
-                        frame, cs_sim_time(r->sim), kept, r->frames_dir);
+                        "%s; %s in %s\n",
+                        frame, cs_sim_time(r->sim), why, kept, r->frames_dir);
             s->status = "unstable";
-            s->error = "NaN or runaway velocity";
+            s->error = why;
             s->failed_frame = frame;
             status = CS_EXIT_UNSTABLE;
             break;
@@ -581,6 +582,7 @@ static int simulate(run_state *r, const run_options *o)
             status = CS_EXIT_OUTPUT;
             break;
         }
+        cs_sim_state_gather(r->sim); /* the state to resume from, on rank 0 */
         if (root)
             status = record_frame(r, frame, &stats, seconds, &progress, sim_start);
         if ((status = cs_sim_agree(r->sim, status)) < 0)
@@ -597,7 +599,8 @@ static int simulate(run_state *r, const run_options *o)
         frames_kept(s->frames_written, kept, sizeof kept);
         fprintf(stderr, "clothsim: interrupted; %s in %s\n", kept, r->frames_dir);
     }
-    if (write_summary(r, err, sizeof err) != 0) {
+    if (write_summary(r, err, sizeof err) != 0 ||
+        cs_outdir_sync(&r->out, true, err, sizeof err) != 0) {
         fprintf(stderr, "clothsim: %s\n", err);
         if (status == CS_EXIT_OK)
             status = CS_EXIT_OUTPUT;
@@ -621,6 +624,7 @@ int cs_run_main(int argc, char **argv)
 
     run_state r;
     memset(&r, 0, sizeof r);
+    r.out.lock = CS_DIR_LOCK_NONE;
     r.start = now_seconds();
     cs_summary_init(&r.summary);
     cs_scene *scene = NULL;
@@ -653,13 +657,20 @@ int cs_run_main(int argc, char **argv)
         goto done;
     }
 
-    r.sim = cs_sim_create(&scene->def, err, sizeof err);
-    if (!r.sim) {
+    rc = cs_sim_create_checked(&scene->def, &r.sim, err, sizeof err);
+    if (rc != CS_OK) {
         if (root)
             fprintf(stderr, "clothsim: %s: %s\n", scene->path, err[0] ? err : "invalid scene");
-        status = CS_EXIT_INPUT;
+        status = rc == CS_ERR_NOMEM ? CS_EXIT_OUTPUT : CS_EXIT_INPUT;
         goto done;
     }
+    if (root && scene->def.dt > cs_sim_stable_dt(r.sim)) /* allowed: damping may hold it */
+        fprintf(stderr,
+                "clothsim: warning: %s: time.dt %.3g s is %.3g times the stability limit "
+                "%.3g s of the undamped elastic forces; damping may keep it stable, and a "
+                "run that blows up stops with exit status 3\n",
+                scene->path, scene->def.dt, scene->def.dt / cs_sim_stable_dt(r.sim),
+                cs_sim_stable_dt(r.sim));
     if (o.plan_only) {
         if (root)
             print_plan(scene, r.sim, stdout);
@@ -667,16 +678,24 @@ int cs_run_main(int argc, char **argv)
         goto done;
     }
 
-    r.out_dir = o.out_dir ? strdup(o.out_dir) : default_out_dir(scene->name);
-    r.frames_dir = r.out_dir ? join_path(r.out_dir, "frames") : NULL;
-    r.summary_path = r.out_dir ? join_path(r.out_dir, "summary.json") : NULL;
     int ncloths = cs_sim_cloth_count(r.sim);
     r.views = calloc(ncloths > 0 ? (size_t)ncloths : 1, sizeof *r.views);
-    if (!r.out_dir || !r.frames_dir || !r.summary_path || !r.views) {
+    if (cs_outdir_init(&r.out, o.out_dir, scene->name) != 0 || !r.views) {
         fprintf(stderr, "clothsim: out of memory\n");
         status = CS_EXIT_OUTPUT;
         goto done;
     }
+    r.frames_dir = r.out.frames_dir;
+    r.summary_path = r.out.summary_path;
+    /* every rank: the same file gives the same outcome */
+    if (cs_run_identity_init(&r.id, scene->path, o.noverrides, (const char *const *)o.overrides,
+                             cs_mesh_format_extension(r.format), r.sim, err, sizeof err) != 0) {
+        if (root)
+            fprintf(stderr, "clothsim: %s\n", err);
+        status = CS_EXIT_OUTPUT;
+        goto done;
+    }
+    cs_state_hash(r.sim, r.summary.initial_hash); /* frame 0's, before any resume */
 
     cs_summary *s = &r.summary;
     int triangles = 0;
@@ -702,7 +721,7 @@ int cs_run_main(int argc, char **argv)
     s->overrides = (const char *const *)o.overrides;
     s->version = CS_VERSION;
     s->format = cs_mesh_format_extension(r.format);
-    s->output_dir = r.out_dir;
+    s->output_dir = r.out.dir;
     s->frames_requested = scene->frames;
     s->fps = scene->def.fps;
     s->dt = cs_sim_dt(r.sim);
@@ -714,7 +733,7 @@ int cs_run_main(int argc, char **argv)
 
     if (o.render && root) {
         r.render = cs_run_render_create(scene, r.sim, o.render, o.render_size, o.render_samples,
-                                        r.out_dir, &status);
+                                        r.out.dir, &status);
         if (!r.render) {
             free(names);
             goto done;
@@ -727,9 +746,8 @@ done:
     cs_run_render_destroy(r.render);
     cs_summary_free(&r.summary);
     free(r.views);
-    free(r.out_dir);
-    free(r.frames_dir);
-    free(r.summary_path);
+    cs_run_identity_free(&r.id);
+    cs_outdir_free(&r.out); /* the lock goes last */
     if (r.sim)
         cs_sim_destroy(r.sim);
     if (scene)

@@ -1,38 +1,29 @@
-/* summary.c: DIR/summary.json and the stage table of `clothsim run`. */
+/* summary.c: DIR/summary.json, DIR/frames.jsonl and the stage table of
+ * `clothsim run`. */
 #include "app/summary.h"
+
+#include "app/fsutil.h"
 
 #include <cJSON.h>
 #include <errno.h>
 #include <stdbool.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 
 void cs_summary_init(cs_summary *s)
 {
     memset(s, 0, sizeof *s);
     s->status = "running";
     s->failed_frame = -1;
+    s->resumed_from = -1;
 }
 
 void cs_summary_free(cs_summary *s)
 {
-    free(s->frames);
-    s->frames = NULL;
-    s->nframes = s->capacity = 0;
-}
-
-int cs_summary_add_frame(cs_summary *s, const cs_frame_record *frame)
-{
-    if (s->nframes == s->capacity) {
-        int cap = s->capacity ? 2 * s->capacity : 64;
-        cs_frame_record *grown = realloc(s->frames, (size_t)cap * sizeof *grown);
-        if (!grown)
-            return -1;
-        s->frames = grown;
-        s->capacity = cap;
-    }
-    s->frames[s->nframes++] = *frame;
-    return 0;
+    if (s->records)
+        fclose(s->records);
+    s->records = NULL;
 }
 
 void cs_summary_take_timing(cs_summary *s, const cs_sim *sim)
@@ -40,15 +31,52 @@ void cs_summary_take_timing(cs_summary *s, const cs_sim *sim)
     const cs_stage_timing *t = cs_sim_stage_timing(sim);
     const cs_comm_stats *c = cs_sim_stage_comm(sim);
     for (int i = 0; i < CS_STAGE_COUNT; i++) {
-        s->timing[i] = t ? t[i] : (cs_stage_timing){0, 0};
+        cs_stage_timing ti = t ? t[i] : (cs_stage_timing){0, 0};
+        cs_comm_stats ci = c ? c[i] : (cs_comm_stats){0, 0, 0};
+        s->timing[i].seconds = s->base_timing[i].seconds + ti.seconds;
+        s->timing[i].calls = s->base_timing[i].calls + ti.calls;
+        s->comm[i].seconds = s->base_comm[i].seconds + ci.seconds;
+        s->comm[i].bytes = s->base_comm[i].bytes + ci.bytes;
+        s->comm[i].messages = s->base_comm[i].messages + ci.messages;
         s->bytes[i] = cs_sim_stage_bytes(sim, (cs_stage)i);
-        s->comm[i] = c ? c[i] : (cs_comm_stats){0, 0, 0};
     }
     s->ranks = cs_sim_ranks(sim);
     s->threads = cs_parallel_threads();
     const cs_comm_stats *per_rank = cs_sim_rank_comm(sim);
     for (int r = 0; r < s->ranks && r < CS_SUMMARY_MAX_RANKS; r++)
         s->rank_comm[r] = per_rank[r];
+}
+
+void cs_summary_totals(const cs_summary *s, double *out)
+{
+    for (int i = 0; i < CS_STAGE_COUNT; i++) {
+        double *o = out + 5 * i;
+        o[0] = s->timing[i].seconds;
+        o[1] = (double)s->timing[i].calls;
+        o[2] = s->comm[i].seconds;
+        o[3] = (double)s->comm[i].bytes;
+        o[4] = (double)s->comm[i].messages;
+    }
+    double *o = out + 5 * CS_STAGE_COUNT;
+    o[0] = s->total_seconds;
+    o[1] = s->simulation_seconds;
+    o[2] = s->output_seconds;
+}
+
+void cs_summary_set_base(cs_summary *s, const double *in)
+{
+    for (int i = 0; i < CS_STAGE_COUNT; i++) {
+        const double *t = in + 5 * i;
+        s->base_timing[i] = (cs_stage_timing){t[0], (long)t[1]};
+        s->base_comm[i] = (cs_comm_stats){t[2], (long)t[3], (long)t[4]};
+        s->timing[i] = s->base_timing[i];
+        s->comm[i] = s->base_comm[i];
+    }
+    const double *t = in + 5 * CS_STAGE_COUNT;
+    s->base_seconds = t[0];
+    s->total_seconds = t[0];
+    s->simulation_seconds = t[1];
+    s->output_seconds = t[2];
 }
 
 static double stage_total(const cs_summary *s)
@@ -162,81 +190,199 @@ static cJSON *build_json(const cs_summary *s, builder *b)
     add_num(b, root, "simulation_seconds", s->simulation_seconds);
     add_num(b, root, "output_seconds", s->output_seconds);
 
-    cJSON *frames = add_array(b, root, "frames");
-    for (int i = 0; i < s->nframes; i++) {
-        const cs_frame_record *f = &s->frames[i];
-        cJSON *o = cJSON_CreateObject();
-        if (o) {
-            add_num(b, o, "frame", f->frame);
-            add_num(b, o, "time", f->time);
-            const cs_frame_stats *st = &f->stats;
-            add_num(b, o, "steps", st->steps);
-            add_num(b, o, "dt", st->dt);
-            add_num(b, o, "cg_iterations", (double)st->cg_iterations);
-            add_num(b, o, "body_contacts", (double)st->body_contacts);
-            add_num(b, o, "max_speed", st->max_speed);
-            if (s->self_collision) {
-                add_num(b, o, "repulsion_pairs", (double)st->repulsion_pairs);
-                add_num(b, o, "repulsions", (double)st->repulsions);
-                add_num(b, o, "collisions", (double)st->collisions);
-                add_num(b, o, "collision_passes", (double)st->collision_passes);
-                add_num(b, o, "impact_zones", (double)st->impact_zones);
-                add_num(b, o, "max_zone_size", (double)st->max_zone_size);
-                add_num(b, o, "rewinds", (double)st->rewinds);
-            }
-            if (st->intersections >= 0)
-                add_num(b, o, "intersections", (double)st->intersections);
-            if (f->body_penetration >= 0)
-                add_num(b, o, "body_penetration_max", f->body_penetration);
-            add_num(b, o, "seconds", f->seconds);
-        }
-        append(b, frames, o);
-    }
+    add_str(b, root, "frames_file", "frames.jsonl");
+    add_str(b, root, "state_file", "state.h5");
+    add_str(b, root, "state_hash_algorithm", CS_STATE_HASH_ALGORITHM);
+    if (s->initial_hash[0])
+        add_str(b, root, "initial_state_hash", s->initial_hash);
+    if (s->resumed_from >= 0)
+        add_num(b, root, "resumed_from_frame", s->resumed_from);
     return root;
 }
 
-int cs_summary_write(const cs_summary *s, const char *path, char *err, size_t errlen)
+/* One frame's record: a line of frames.jsonl, an entry of "frames". */
+static cJSON *frame_json(const cs_summary *s, const cs_frame_record *f, builder *b)
+{
+    cJSON *o = cJSON_CreateObject();
+    if (!o) {
+        b->ok = false;
+        return NULL;
+    }
+    add_num(b, o, "frame", f->frame);
+    add_num(b, o, "time", f->time);
+    const cs_frame_stats *st = &f->stats;
+    add_num(b, o, "steps", st->steps);
+    add_num(b, o, "dt", st->dt);
+    add_num(b, o, "cg_iterations", (double)st->cg_iterations);
+    add_num(b, o, "body_contacts", (double)st->body_contacts);
+    add_num(b, o, "max_speed", st->max_speed);
+    if (s->self_collision) {
+        add_num(b, o, "repulsion_pairs", (double)st->repulsion_pairs);
+        add_num(b, o, "repulsions", (double)st->repulsions);
+        add_num(b, o, "collisions", (double)st->collisions);
+        add_num(b, o, "collision_passes", (double)st->collision_passes);
+        add_num(b, o, "impact_zones", (double)st->impact_zones);
+        add_num(b, o, "max_zone_size", (double)st->max_zone_size);
+        add_num(b, o, "rewinds", (double)st->rewinds);
+    }
+    if (st->intersections >= 0)
+        add_num(b, o, "intersections", (double)st->intersections);
+    if (f->body_penetration >= 0)
+        add_num(b, o, "body_penetration_max", f->body_penetration);
+    add_num(b, o, "seconds", f->seconds);
+    add_str(b, o, "state_hash", f->state_hash);
+    return o;
+}
+
+/* ------------------------------------------------------------ frames.jsonl */
+
+/* Calls fn on each whole line of text (a trailing partial line, left by a
+ * run killed mid-write, is not one). Stops at the first nonzero return. */
+static int each_line(char *text, int (*fn)(char *line, void *ctx), void *ctx)
+{
+    for (char *line = text, *end; (end = strchr(line, '\n')) != NULL; line = end + 1) {
+        *end = '\0';
+        int rc = fn(line, ctx);
+        *end = '\n';
+        if (rc)
+            return rc;
+    }
+    return 0;
+}
+
+typedef struct trim_ctx {
+    int keep, next;       /* keep frames 1..keep; the frame expected next */
+    size_t kept;          /* bytes of text kept */
+    const char *text;
+} trim_ctx;
+
+static int trim_line(char *line, void *ctx)
+{
+    trim_ctx *t = ctx;
+    cJSON *o = cJSON_Parse(line);
+    const cJSON *f = o ? cJSON_GetObjectItemCaseSensitive(o, "frame") : NULL;
+    int frame = cJSON_IsNumber(f) ? f->valueint : -1;
+    cJSON_Delete(o);
+    if (frame != t->next)
+        return -1; /* damaged, or a frame missing: t->next names it */
+    t->next++;
+    t->kept = (size_t)(line - t->text) + strlen(line) + 1;
+    return t->next > t->keep ? 1 : 0;
+}
+
+int cs_summary_open_records(cs_summary *s, const char *path, int keep, char *err,
+                            size_t errlen)
+{
+    s->records_path = path;
+    s->nframes = 0;
+    s->records_size = 0;
+    if (keep > 0) { /* resuming: keep frames 1..keep, whole lines only */
+        size_t len = 0;
+        char *text = cs_file_read_all(path, &len);
+        if (!text) {
+            snprintf(err, errlen, "cannot read %s: %s", path, strerror(errno));
+            return -1;
+        }
+        trim_ctx t = {keep, 1, 0, text};
+        each_line(text, trim_line, &t);
+        if (t.next <= keep) {
+            snprintf(err, errlen, "%s: the record of frame %d is missing or damaged; the run "
+                     "cannot be continued", path, t.next);
+            free(text);
+            return -1;
+        }
+        int rc = cs_file_write_atomic(path, text, t.kept, err, errlen);
+        free(text);
+        if (rc != 0)
+            return -1;
+        s->nframes = keep;
+        s->records_size = (long)t.kept;
+    }
+    s->records = fopen(path, keep > 0 ? "ab" : "wb");
+    if (!s->records) {
+        snprintf(err, errlen, "cannot write %s: %s", path, strerror(errno));
+        return -1;
+    }
+    return 0;
+}
+
+int cs_summary_add_frame(cs_summary *s, const cs_frame_record *frame, char *err, size_t errlen)
+{
+    builder b = {true};
+    cJSON *o = frame_json(s, frame, &b);
+    char *text = b.ok ? cJSON_PrintUnformatted(o) : NULL;
+    cJSON_Delete(o);
+    if (!text) {
+        snprintf(err, errlen, "cannot write %s: out of memory", s->records_path);
+        return -1;
+    }
+    errno = 0;
+    size_t len = strlen(text);
+    bool ok = s->records && fputs(text, s->records) >= 0 && fputc('\n', s->records) != EOF &&
+              fflush(s->records) == 0;
+    free(text);
+    if (!ok) {
+        snprintf(err, errlen, "cannot write %s: %s", s->records_path,
+                 strerror(errno ? errno : EIO));
+        if (s->records) { /* no half record: back to the last whole one */
+            clearerr(s->records);
+            if (ftruncate(fileno(s->records), s->records_size) != 0)
+                fprintf(stderr, "clothsim: cannot cut %s back to its last whole record: %s\n",
+                        s->records_path, strerror(errno));
+        }
+        return -1;
+    }
+    s->records_size += (long)len + 1;
+    s->nframes++;
+    return 0;
+}
+
+typedef struct gather_ctx {
+    builder *b;
+    cJSON *frames;
+} gather_ctx;
+
+static int gather_line(char *line, void *ctx)
+{
+    gather_ctx *g = ctx;
+    cJSON *o = cJSON_Parse(line);
+    if (!o)
+        return -1;
+    append(g->b, g->frames, o);
+    return 0;
+}
+
+int cs_summary_write(const cs_summary *s, const char *path, bool final, char *err,
+                     size_t errlen)
 {
     builder b = {true};
     cJSON *root = build_json(s, &b);
+    if (final && b.ok) { /* the records on disk are the run's frames */
+        size_t len = 0;
+        char *records = s->records_path ? cs_file_read_all(s->records_path, &len) : NULL;
+        gather_ctx g = {&b, add_array(&b, root, "frames")};
+        if (s->records_path && !records) {
+            snprintf(err, errlen, "cannot read %s: %s", s->records_path, strerror(errno));
+            cJSON_Delete(root);
+            return -1;
+        }
+        if (records && each_line(records, gather_line, &g) != 0) {
+            snprintf(err, errlen, "%s: a record is damaged", s->records_path);
+            free(records);
+            cJSON_Delete(root);
+            return -1;
+        }
+        free(records);
+    }
     char *text = b.ok ? cJSON_Print(root) : NULL;
     cJSON_Delete(root);
     if (!text) {
         snprintf(err, errlen, "cannot write %s: out of memory", path);
         return -1;
     }
-
-    size_t len = strlen(path);
-    char *tmp = malloc(len + 5);
-    if (!tmp) {
-        free(text);
-        snprintf(err, errlen, "cannot write %s: out of memory", path);
-        return -1;
-    }
-    memcpy(tmp, path, len);
-    memcpy(tmp + len, ".tmp", 5);
-
-    int rc = -1;
-    FILE *fp = fopen(tmp, "w");
-    if (!fp) {
-        snprintf(err, errlen, "cannot write %s: %s", tmp, strerror(errno));
-    } else {
-        bool written = fputs(text, fp) >= 0 && fputc('\n', fp) != EOF;
-        int saved = errno;
-        if (fclose(fp) != 0 && written) {
-            written = false;
-            saved = errno;
-        }
-        if (!written)
-            snprintf(err, errlen, "cannot write %s: %s", tmp, strerror(saved));
-        else if (rename(tmp, path) != 0)
-            snprintf(err, errlen, "cannot rename %s to %s: %s", tmp, path, strerror(errno));
-        else
-            rc = 0;
-        if (rc != 0)
-            remove(tmp);
-    }
-    free(tmp);
+    size_t len = strlen(text);
+    text[len] = '\n'; /* in place of the terminator: the file ends with a newline */
+    int rc = cs_file_write_atomic(path, text, len + 1, err, errlen);
     free(text);
     return rc;
 }

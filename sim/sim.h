@@ -442,6 +442,36 @@ long cs_find_intersections(int nv, const double *x, int nt, const int *tri, int 
  * (3 vertices of 3 doubles each, possibly degenerate) intersect. */
 bool cs_triangles_intersect(const double p[9], const double q[9]);
 
+/* ------------------------------------------- state for resuming (checkpoint.c) */
+
+/* Everything the end of a frame leaves for the next frames to read, as
+ * named arrays of doubles the caller stores and gives back: a simulation
+ * created from the same definition and given them continues bit for bit as
+ * the one that exported them (at the same rank count). Whatever a step
+ * recomputes before reading (forces, contacts, pairs, trees, scratch) is
+ * not state; what it reads from an earlier step is, and is listed here. */
+typedef struct cs_state_array {
+    const char *name;   /* "time", "positions", "cg/warm_half", ... */
+    size_t count;       /* doubles */
+    double *data;       /* into the simulation: read to store, write to restore */
+} cs_state_array;
+
+enum { CS_STATE_MAX_ARRAYS = 8 };
+
+/* The arrays (at most CS_STATE_MAX_ARRAYS) in *arrays; returns how many.
+ * The list and the sizes are the same on every rank and for every
+ * simulation of the same definition. */
+int cs_sim_state_arrays(cs_sim *sim, cs_state_array *arrays);
+
+/* A collective, after cs_sim_advance_frame: rank 0's arrays then hold every
+ * particle's values (other ranks keep theirs). Counts as no stage's
+ * communication. */
+void cs_sim_state_gather(cs_sim *sim);
+
+/* A collective, after rank 0 wrote stored values into its arrays: every
+ * rank takes rank 0's. Returns CS_OK or CS_ERR_NOMEM (on every rank). */
+int cs_sim_state_scatter(cs_sim *sim);
+
 #ifdef __cplusplus
 }
 #endif
