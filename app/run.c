@@ -657,6 +657,7 @@ int cs_run_main(int argc, char **argv)
         goto done;
     }
 
+    scene->def.plan_only = o.plan_only; /* --plan allocates nothing the step needs */
     rc = cs_sim_create_checked(&scene->def, &r.sim, err, sizeof err);
     if (rc != CS_OK) {
         if (root)

@@ -215,23 +215,17 @@ int cs_sim_create_checked(const cs_sim_def *def, cs_sim **out, char *err, size_t
     sim->is_free = calloc((size_t)n + 1, 1);
     sim->mode = calloc((size_t)n + 1, 1);
     sim->cloths = calloc((size_t)def->ncloths, sizeof *sim->cloths);
-    sim->x_prev = alloc3(n);
-    sim->v_half = alloc3(n);
-    sim->v_star = alloc3(n);
-    sim->v_next = alloc3(n);
-    sim->force = alloc3(n);
-    sim->v0 = alloc3(n);
-    sim->rhs = alloc3(n);
-    double **cg[] = {&sim->cg.z, &sim->cg.r, &sim->cg.y, &sim->cg.p, &sim->cg.q,
-                     &sim->cg.b, &sim->cg.explicit_z, &sim->cg.warm_half,
-                     &sim->cg.warm_full};
-    bool ok = sim->x && sim->v && sim->mass && sim->is_free && sim->mode && sim->cloths &&
-              sim->x_prev && sim->v_half && sim->v_star && sim->v_next && sim->force &&
-              sim->v0 && sim->rhs;
-    for (size_t k = 0; k < sizeof cg / sizeof *cg && ok; k++)
-        ok = (*cg[k] = alloc3(n)) != NULL;
-    ok = ok && (sim->cg.partial = calloc(2 * ((size_t)n / CS_BLOCK + 1), sizeof(double)));
-    ok = ok && (sim->cg.block = calloc(6 * (size_t)n + 6, sizeof(double)));
+    bool ok = sim->x && sim->v && sim->mass && sim->is_free && sim->mode && sim->cloths;
+    if (ok && !def->plan_only) { /* the step's scratch */
+        double **scratch[] = {&sim->x_prev, &sim->v_half, &sim->v_star, &sim->v_next,
+                              &sim->force, &sim->v0, &sim->rhs, &sim->cg.z, &sim->cg.r,
+                              &sim->cg.y, &sim->cg.p, &sim->cg.q, &sim->cg.b,
+                              &sim->cg.explicit_z, &sim->cg.warm_half, &sim->cg.warm_full};
+        for (size_t k = 0; k < sizeof scratch / sizeof *scratch && ok; k++)
+            ok = (*scratch[k] = alloc3(n)) != NULL;
+        ok = ok && (sim->cg.partial = calloc(2 * ((size_t)n / CS_BLOCK + 1), sizeof(double)));
+        ok = ok && (sim->cg.block = calloc(6 * (size_t)n + 6, sizeof(double)));
+    }
     if (!ok)
         goto nomem;
 
@@ -314,14 +308,14 @@ int cs_sim_create_checked(const cs_sim_def *def, cs_sim **out, char *err, size_t
                 goto nomem;
         }
     }
-    if (cs_plan_has(&sim->plan, CS_STAGE_BODY_COLLISION)) {
+    if (cs_plan_has(&sim->plan, CS_STAGE_BODY_COLLISION) && !def->plan_only) {
         sim->contact_normal = alloc3(n);
         sim->contact_body = calloc((size_t)n + 1, sizeof *sim->contact_body);
         if (!sim->contact_normal || !sim->contact_body)
             goto nomem;
         sim->stage_bytes[CS_STAGE_BODY_COLLISION] = (3 * sizeof(double) + sizeof(int)) * (size_t)n;
     }
-    if (cs_plan_has(&sim->plan, CS_STAGE_WIND)) {
+    if (cs_plan_has(&sim->plan, CS_STAGE_WIND) && !def->plan_only) {
         sim->wind_normal = alloc3(n);
         sim->wind_area = calloc((size_t)n + 1, sizeof *sim->wind_area);
         if (!sim->wind_normal || !sim->wind_area)
@@ -329,7 +323,7 @@ int cs_sim_create_checked(const cs_sim_def *def, cs_sim **out, char *err, size_t
         sim->stage_bytes[CS_STAGE_WIND] = 4 * sizeof(double) * (size_t)n;
     }
 
-    if (cs_plan_has(&sim->plan, CS_STAGE_COLLISIONS)) {
+    if (cs_plan_has(&sim->plan, CS_STAGE_COLLISIONS) && !def->plan_only) {
         sim->selfcol = cs_selfcol_create(sim);
         if (!sim->selfcol)
             goto nomem;
@@ -376,6 +370,10 @@ int cs_sim_create_checked(const cs_sim_def *def, cs_sim **out, char *err, size_t
     }
     sim->dt = frame / (steps >= 1 ? steps : 1);
     cs_runaway_init(sim); /* from all springs and particles, like the step */
+    if (def->plan_only) { /* the step size is all a plan needs */
+        *out = sim;
+        return CS_OK;
+    }
 
     sim->nsprings = sim->springs.n;
     /* Section 7: owners and ghosts; each rank keeps the springs it needs */

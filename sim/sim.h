@@ -243,6 +243,11 @@ typedef struct cs_sim_def {
      * Without MPI initialised, or with MPI_COMM_NULL, it is one rank and
      * makes no MPI call. */
     MPI_Comm comm;
+    /* Only the plan and the step size are wanted (clothsim run --plan):
+     * particles, masses and springs are built for Lanczos, and nothing the
+     * step needs (scratch, solver, contacts, self-collision, partition) is
+     * allocated; such a simulation cannot advance. */
+    bool plan_only;
 } cs_sim_def;
 
 cs_sim_def cs_default_sim_def(void);

@@ -30,6 +30,19 @@ run 2 run "$DRAPE" --set 'cloths.0.grid.resolution=[20000,17000]' --plan
 err_has 'cloths\[0\].grid.resolution: 20000 x 17000 quads \(3.4e\+08 particles\) to simulate: would need about .* of memory, but .* is available'
 [ ! -s out.txt ] || fail "a refused scene printed a plan"
 
+# --plan builds only what the step size needs (mesh, masses, springs for
+# Lanczos: about 0.5 kB a particle), not the step's arrays, the solver or
+# self-collision (6 kB a particle estimated for a run): a 400 x 400 sheet
+python3 - "$EXE" "$DRAPE" <<'EOF' || fail "--plan allocated what a run needs"
+import resource, subprocess, sys
+exe, scene = sys.argv[1:3]
+subprocess.run([exe, "run", scene, "--plan", "--set", "cloths.0.grid.resolution=[400,400]",
+                "--set", "effects.self_collision=true"], check=True, stdout=subprocess.DEVNULL)
+peak = resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss * 1024
+run_estimate = 6000 * 401 * 401
+assert peak < 0.4 * run_estimate, (peak, run_estimate)
+EOF
+
 # a fixed step above the limit is allowed (damping may hold it) but warned
 run 0 run "$DRAPE" --set "$SMALL" --set time.dt=0.003 --plan
 err_has 'warning: .*time.dt 0.003 s is 1.19 times the stability limit 0.00251 s'
