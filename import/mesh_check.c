@@ -180,6 +180,9 @@ static int parse_header(checker *c, char *buf, size_t n, ply_header *h)
                 FAIL(c, "PLY header has more than %d elements", MAX_ELEMENTS);
             if (!name || !count || !isdigit((unsigned char)count[0]))
                 FAIL(c, "PLY header line %d: expected 'element NAME COUNT'", line);
+            for (int k = 0; k < h->nelems; k++) /* assimp aborts on a repeat (found by fuzzing) */
+                if (!strcmp(h->elems[k].name, name))
+                    FAIL(c, "PLY header line %d: element '%.40s' is declared twice", line, name);
             ply_elem *e = &h->elems[h->nelems++];
             snprintf(e->name, sizeof e->name, "%s", name);
             errno = 0;
@@ -573,8 +576,18 @@ int cs_mesh_precheck(const char *path, cs_mesh_precheck_result *res, char *err, 
     }
     unsigned char head[4096];
     size_t n = fread(head, 1, sizeof head, f);
-    if (n >= 4 && !strncasecmp((const char *)head, "ply", 3) &&
-        (head[3] == '\n' || head[3] == '\r'))
+    /* assimp takes any file that starts with "ply" for a PLY file; with
+     * anything but a line end after it, its reader crashed or looped
+     * (found by fuzzing: "plyR", "ply@") */
+    if (n >= 3 && !strncasecmp((const char *)head, "ply", 3) &&
+        (n == 3 || (head[3] != '\n' && head[3] != '\r'))) {
+        fclose(f);
+        cs_mesh_set_err(err, errlen,
+                        "cannot read %s: it starts like a PLY file but its first line is not "
+                        "'ply'", path);
+        return CS_IMPORT_BAD_INPUT;
+    }
+    if (n >= 4 && !strncasecmp((const char *)head, "ply", 3))
         res->kind = CS_KIND_PLY;
     else if ((n >= 4 && !memcmp(head, "glTF", 4)) || has_extension(path, "gltf"))
         res->kind = CS_KIND_GLTF;
