@@ -56,7 +56,7 @@ void cs_state_hash(const cs_sim *sim, char hex[CS_STATE_HASH_LEN])
 
 int cs_run_identity_init(cs_run_identity *id, const char *scene_file, int noverrides,
                          const char *const *overrides, const char *format, const cs_sim *sim,
-                         char *err, size_t errlen)
+                         const cs_scene *scene, char *err, size_t errlen)
 {
     memset(id, 0, sizeof *id);
     id->scene_file = scene_file;
@@ -77,9 +77,26 @@ int cs_run_identity_init(cs_run_identity *id, const char *scene_file, int noverr
         return -1;
     }
     memcpy(mass3, cs_sim_masses(sim), sizeof(double) * (size_t)n);
+    /* a body's mesh file may change under the same scene text: its mesh
+     * as imported, body by body */
+    XXH128_hash_t bodies = {0, 0};
+    XXH3_state_t *h = XXH3_createState();
+    if (h && XXH3_128bits_reset(h) == XXH_OK) {
+        for (int b = 0; b < scene->def.nbodies && scene->mesh_bodies; b++) {
+            const cs_trimesh *m = scene->mesh_bodies[b].mesh;
+            if (!m)
+                continue;
+            XXH3_128bits_update(h, &b, sizeof b);
+            XXH3_128bits_update(h, m->x, sizeof *m->x * 3 * (size_t)m->nv);
+            XXH3_128bits_update(h, m->tri, sizeof *m->tri * 3 * (size_t)m->nt);
+        }
+        bodies = XXH3_128bits_digest(h);
+    }
+    XXH3_freeState(h);
     struct {
         double n, dt;
-    } head = {(double)n, cs_sim_dt(sim)};
+        XXH128_hash_t bodies;
+    } head = {(double)n, cs_sim_dt(sim), bodies};
     const double *arrays[] = {cs_sim_positions(sim), cs_sim_velocities(sim), mass3};
     hash_arrays(sim, &head, sizeof head, arrays, 3, id->definition_hash);
     free(mass3);
@@ -466,8 +483,8 @@ static int compare_identity(hid_t f, const char *path, const cs_run_identity *id
                  "had %d", path, id->particles, particles);
     else if (strcmp(definition, id->definition_hash) != 0)
         snprintf(err, errlen, "cannot resume from %s: the scene's initial state (positions, "
-                 "velocities, masses or step) differs from the run's although its text and "
-                 "overrides do not: did a mesh file it reads change?", path);
+                 "velocities, masses, step or a body's mesh) differs from the run's although "
+                 "its text and overrides do not: did a mesh file it reads change?", path);
     else
         rc = 0;
     free(text);

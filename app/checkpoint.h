@@ -23,6 +23,7 @@
 #include <stddef.h>
 
 #include "app/summary.h"
+#include "import/import.h"
 #include "sim/sim.h"
 
 /* What a run is made from; a resumed run must be made from the same. */
@@ -40,11 +41,13 @@ typedef struct cs_run_identity {
     char definition_hash[CS_STATE_HASH_LEN];
 } cs_run_identity;
 
-/* Reads the scene file and hashes the definition of sim (just created).
- * Returns 0, or -1 with err. */
+/* Reads the scene file and hashes the definition of sim (just created
+ * from scene): what the scene's text does not hold, the contents of the
+ * mesh files it names (cloths through the initial positions, bodies through
+ * their meshes as imported). Returns 0, or -1 with err. */
 int cs_run_identity_init(cs_run_identity *id, const char *scene_file, int noverrides,
                          const char *const *overrides, const char *format, const cs_sim *sim,
-                         char *err, size_t errlen);
+                         const cs_scene *scene, char *err, size_t errlen);
 void cs_run_identity_free(cs_run_identity *id);
 
 /* XXH3-128 of the positions then the velocities as stored (rank 0 after a

@@ -690,7 +690,8 @@ int cs_run_main(int argc, char **argv)
     r.summary_path = r.out.summary_path;
     /* every rank: the same file gives the same outcome */
     if (cs_run_identity_init(&r.id, scene->path, o.noverrides, (const char *const *)o.overrides,
-                             cs_mesh_format_extension(r.format), r.sim, err, sizeof err) != 0) {
+                             cs_mesh_format_extension(r.format), r.sim, scene, err,
+                             sizeof err) != 0) {
         if (root)
             fprintf(stderr, "clothsim: %s\n", err);
         status = CS_EXIT_OUTPUT;
