@@ -16,8 +16,9 @@
 #                   input as scenes/fuzz.yaml), assets/ (copies of the
 #                   small assets, with stanford-bunny.obj standing in as
 #                   ico4.obj at the bunny's size, 642 vertices against
-#                   the bunny's 35,947, so that bunny_drape's mutants load
-#                   in a fraction of a second), cache/ (level-set cache)
+#                   the bunny's 35,947, so that each of bunny_drape's
+#                   mutants imports a small mesh), cache/ (level-set cache)
+#   artifacts/      where the README's commands put what they find
 set -eu
 root=$(cd "$(dirname "$0")/.." && pwd)
 build=${1:-"$root/build-fuzz"}
@@ -25,6 +26,7 @@ small=131072
 seeds="$build/seeds"
 rm -rf "$seeds"
 mkdir -p "$seeds/scene" "$seeds/mesh" "$build/corpus/scene" "$build/corpus/mesh" \
+         "$build/artifacts/scene" "$build/artifacts/mesh" \
          "$build/fuzz-root/scenes" "$build/fuzz-root/assets" "$build/fuzz-root/cache"
 
 # ---- working folder: copies of the small assets (and what they refer to)
