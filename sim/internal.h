@@ -78,7 +78,8 @@ struct cs_sim {
     double *wind_area;            /* 1 per particle */
 
     double t, dt, h;              /* h: half step of the current solve */
-    double stable_dt;             /* 2 / omega_max, omega_max^2 by Lanczos */
+    double stable_dt;             /* the damped scheme's limit at rest (step_limit.c) */
+    double undamped_dt;           /* 2 / omega_max, omega_max^2 by Lanczos */
     double gershgorin_dt;         /* the same from Gershgorin's bound (smaller) */
     cs_par *par;                  /* ownership, ghosts, messages (Section 7) */
     unsigned char *active;        /* free and owned here: bodies act on these */
@@ -116,6 +117,12 @@ double cs_runaway_limit(const cs_sim *sim, double t);
 void cs_runaway_begin_step(cs_sim *sim, double t1);
 void cs_runaway_check(cs_sim *sim, const double *v, cs_stage stage);
 bool cs_runaway_end_step(cs_sim *sim);
+
+/* step_limit.c: the stability limits at the rest state (stable_dt,
+ * undamped_dt, gershgorin_dt), and the limit at the current positions
+ * (collective: every rank calls it at the same point). */
+void cs_step_limit_init(cs_sim *sim);
+double cs_step_limit_now(cs_sim *sim);
 
 /* contact.c: Section 6. */
 void cs_gamma(const double v[3], const double N[3], const double vb[3], double mu,

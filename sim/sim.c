@@ -155,9 +155,6 @@ static int copy_motion(cs_motion *dst, const cs_motion *src)
     return 0;
 }
 
-/* Lanczos iterations for the largest eigenvalue of M^-1 K (the step) */
-enum { LANCZOS_STEPS = 60 };
-
 static double *alloc3(int n) { return calloc((size_t)n * 3 + 3, sizeof(double)); }
 
 /* Vertex masses: the node mass, or a third of the area of the adjacent
@@ -336,22 +333,11 @@ int cs_sim_create_checked(const cs_sim_def *def, cs_sim **out, char *err, size_t
         }
     }
 
-    /* time step: the explicit elastic forces are stable for dt < 2 / omega_max
-     * (the scheme's amplification matrix has determinant 1 and trace
-     * 2 - dt^2 omega^2). omega_max^2, the largest eigenvalue of M^-1 K, comes
-     * from Lanczos iterations (converged to 1e-4 within 40 on the grids
-     * measured); Gershgorin's bound, about twice as large on cloth meshes,
-     * stays as the fallback and is shown beside it. Every rank computes the
-     * same from all springs (before the partition keeps its own). */
-    double bound = cs_springs_stiffness_bound(&sim->springs, sim->mass, sim->is_free, n);
-    double lambda = bound > 0 ? cs_springs_max_eigenvalue(&sim->springs, sim->x, sim->mass,
-                                                          sim->is_free, n, LANCZOS_STEPS)
-                              : 0;
-    if (!(lambda > 0) || lambda > bound)
-        lambda = bound;
+    /* time step: the damped scheme's limit at the rest state (step_limit.c),
+     * from all springs on every rank (before the partition keeps its own);
+     * advance_frame refreshes it from the tension before each outer step */
+    cs_step_limit_init(sim);
     double frame = 1.0 / def->fps;
-    sim->gershgorin_dt = bound > 0 ? 2.0 / sqrt(bound) : INFINITY;
-    sim->stable_dt = lambda > 0 ? 2.0 / sqrt(lambda) : INFINITY;
     double dt_max = def->dt > 0 ? def->dt : def->dt_safety * sim->stable_dt;
     if (dt_max > frame)
         dt_max = frame;
@@ -523,6 +509,27 @@ static void copy_ranges(const int *ranges, int nranges, double *dst, const doubl
                sizeof(double) * 3 * (size_t)(ranges[2 * r + 1] - ranges[2 * r]));
 }
 
+/* The improved method applies B.5's forces without the contact
+ * projection, so that B.7 sees the normal force. Where that force pulls a
+ * contact particle off the body, nothing in B.5 damped the pull (the
+ * projection held the normal velocity), and at steps far above the
+ * undamped limit the explicit pull grows without bound. Such a particle
+ * leaves the body: it takes the projected solve's velocity, as the
+ * previous method would give it, and B.4 stops holding it next step. */
+static void release_separating(cs_sim *sim, int i, double t1, const double *v_p)
+{
+    int b = sim->contact_body[i];
+    if (b < 0)
+        return;
+    double vb[3], rel[3];
+    cs_body_def_velocity(sim->bodies + b, t1, sim->x + 3 * i, vb);
+    cs_sub(sim->v_next + 3 * i, vb, rel);
+    if (cs_dot(rel, sim->contact_normal + 3 * i) <= 0)
+        return;
+    for (int d = 0; d < 3; d++)
+        sim->v_next[3 * i + d] = 2.0 * v_p[3 * i + d] - sim->v_star[3 * i + d];
+}
+
 /* True on every rank when every owned particle is finite everywhere. */
 int cs_sim_step(cs_sim *sim, double dt)
 {
@@ -620,12 +627,14 @@ int cs_sim_step(cs_sim *sim, double dt)
         copy_ranges(par->local, par->nlocal, sim->v_next, sim->force);
         cs_halo_forward(par, &par->ghosts, v_p, 3);
         cs_damping_apply(sim, v_p, sim->v_next); /* F_i + F_d v_P */
-        CS_FOR_OWNED(par, i)
+        CS_FOR_OWNED(par, i) {
             for (int d = 0; d < 3; d++) {
                 int k = 3 * i + d;
                 double v_np = sim->v_star[k] + sim->h / sim->mass[i] * sim->v_next[k];
                 sim->v_next[k] = 2.0 * v_np - sim->v_star[k];
             }
+            release_separating(sim, i, t1, v_p);
+        }
     } else {
         CS_FOR_OWNED(par, i)
             for (int d = 0; d < 3; d++)
@@ -705,10 +714,28 @@ static int outer_step(cs_sim *sim, int k)
     }
 }
 
+/* The step for the rest of a frame: the frame's remaining time in equal
+ * steps no longer than dt_safety times the stability limit at the current
+ * positions (or the scene's fixed step). Returns the number of steps. */
+static long steps_for(cs_sim *sim, double remaining)
+{
+    if (sim->def.dt > 0) /* fixed: the step set at creation */
+        return lround(remaining / sim->dt);
+    double dt_max = sim->def.dt_safety * cs_step_limit_now(sim);
+    double steps = ceil(remaining / fmin(dt_max, remaining) - 1e-9);
+    if (!(steps >= 1))
+        steps = 1;
+    if (steps > CS_MAX_STEPS_PER_FRAME)
+        steps = CS_MAX_STEPS_PER_FRAME;
+    sim->dt = remaining / steps;
+    return (long)steps;
+}
+
 int cs_sim_advance_frame(cs_sim *sim, cs_frame_stats *stats)
 {
     double frame = 1.0 / sim->def.fps;
-    int steps = (int)lround(frame / sim->dt);
+    double t_end = sim->t + frame;
+    long steps = 0;
     long cg0 = sim->cg_iterations, contacts0 = sim->contacts;
     cs_selfcol_stats self0 = {0};
     if (sim->selfcol) {
@@ -717,12 +744,21 @@ int cs_sim_advance_frame(cs_sim *sim, cs_frame_stats *stats)
     }
     int status = CS_OK;
     /* The outer collision loop: k_i time steps, then step C. Chunks never
-     * straddle a frame end, so every frame ends collision-free. */
-    for (int s = 0; s < steps && status == CS_OK;) {
-        int chunk = steps - s < sim->def.collision_steps ? steps - s : sim->def.collision_steps;
-        status = outer_step(sim, chunk);
-        s += chunk;
+     * straddle a frame end, so every frame ends collision-free. The step is
+     * chosen afresh before each chunk, from the tension the cloth has then
+     * (step_limit.c); the steps left divide the frame's remaining time. */
+    bool adaptive = !(sim->def.dt > 0);
+    long left = steps_for(sim, frame);
+    while (left > 0 && status == CS_OK) {
+        long chunk = left < sim->def.collision_steps ? left : sim->def.collision_steps;
+        status = outer_step(sim, (int)chunk);
+        steps += chunk;
+        left -= chunk;
+        if (left > 0 && adaptive && status == CS_OK)
+            left = steps_for(sim, t_end - sim->t);
     }
+    if (status == CS_OK && adaptive)
+        sim->t = t_end; /* the frame's time, free of the steps' round-off */
     /* rank 0 gets the whole state: frames are written once */
     cs_par_begin(sim->par, CS_STAGE_POSITION_UPDATE);
     cs_par_gather_root(sim->par, sim->x, 3);
@@ -749,8 +785,8 @@ int cs_sim_advance_frame(cs_sim *sim, cs_frame_stats *stats)
     cs_par_report(sim->par, sim->timing, sim->timing_all, sim->comm_all, sim->rank_comm);
     if (stats) {
         memset(stats, 0, sizeof *stats);
-        stats->steps = steps;
-        stats->dt = sim->dt;
+        stats->steps = (int)steps;
+        stats->dt = frame / (double)steps; /* the mean step */
         stats->cg_iterations = sim->cg_iterations - cg0;
         stats->body_contacts = sums[0];
         stats->max_speed = max_speed;
@@ -792,6 +828,7 @@ long cs_sim_count_intersections(const cs_sim *sim)
 double cs_sim_time(const cs_sim *sim) { return sim->t; }
 double cs_sim_dt(const cs_sim *sim) { return sim->dt; }
 double cs_sim_stable_dt(const cs_sim *sim) { return sim->stable_dt; }
+double cs_sim_undamped_dt(const cs_sim *sim) { return sim->undamped_dt; }
 double cs_sim_gershgorin_dt(const cs_sim *sim) { return sim->gershgorin_dt; }
 int cs_sim_particle_count(const cs_sim *sim) { return sim->n; }
 int cs_sim_spring_count(const cs_sim *sim) { return sim->nsprings; }

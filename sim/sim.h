@@ -332,10 +332,9 @@ typedef struct cs_sim cs_sim;
 /* Creates the simulation: CS_OK and *out, or CS_ERR_INVALID (a definition
  * that cannot run, such as a step so small a frame would need more than
  * CS_MAX_STEPS_PER_FRAME) or CS_ERR_NOMEM, with why in err. A fixed step
- * above cs_sim_stable_dt is allowed: that limit ignores damping, which the
- * solve treats implicitly and which lets Table 1's cloth run stably at many
- * times it (40 times on an 8 x 8 hanging sheet); callers should warn, and
- * cs_sim_runaway reports a step that does blow up. */
+ * above cs_sim_stable_dt is allowed (the limit is a sufficient condition,
+ * not a necessary one); callers should warn, and cs_sim_runaway reports a
+ * step that does blow up. */
 int cs_sim_create_checked(const cs_sim_def *def, cs_sim **out, char *err, size_t errlen);
 /* The same; on failure returns NULL and writes why into err. */
 cs_sim *cs_sim_create(const cs_sim_def *def, char *err, size_t errlen);
@@ -381,8 +380,13 @@ long cs_sim_count_intersections(const cs_sim *sim);
 
 double cs_sim_time(const cs_sim *sim);
 double cs_sim_dt(const cs_sim *sim);          /* step used by advance_frame */
-double cs_sim_stable_dt(const cs_sim *sim);   /* stability limit, 2 / omega_max (Lanczos) */
-double cs_sim_gershgorin_dt(const cs_sim *sim); /* the same from Gershgorin's bound */
+/* Stability limits at the rest state: the damped scheme's (the largest of
+ * its Gershgorin test and the undamped limit; the automatic step is
+ * dt_safety times it, refreshed from the cloth's tension before each outer
+ * step), and the undamped 2 / omega_max by Lanczos and by Gershgorin. */
+double cs_sim_stable_dt(const cs_sim *sim);
+double cs_sim_undamped_dt(const cs_sim *sim);
+double cs_sim_gershgorin_dt(const cs_sim *sim);
 int cs_sim_particle_count(const cs_sim *sim);
 int cs_sim_spring_count(const cs_sim *sim); /* edge and bending springs */
 const double *cs_sim_positions(const cs_sim *sim);

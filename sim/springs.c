@@ -266,6 +266,45 @@ double cs_springs_stiffness_bound(const cs_springs *s, const double *mass,
     return bound;
 }
 
+double cs_springs_rest_step_bound(const cs_springs *s, const double *mass,
+                                  const unsigned char *is_free, int nparticles, double dt)
+{
+    double *sum = calloc((size_t)nparticles + 1, sizeof *sum);
+    if (!sum)
+        return INFINITY;
+    for (int k = 0; k < s->n; k++) {
+        double term = cs_spring_step_term(dt, s->stiffness[k] * s->inv_rest_length[k],
+                                          s->damping[k], 0);
+        sum[s->ends[2 * k]] += term;
+        sum[s->ends[2 * k + 1]] += term;
+    }
+    double bound = 0;
+    for (int i = 0; i < nparticles; i++)
+        if (is_free[i] && 2.0 * sum[i] / mass[i] > bound)
+            bound = 2.0 * sum[i] / mass[i];
+    free(sum);
+    return bound;
+}
+
+double cs_springs_step_bound(const cs_springs *s, const double *mass,
+                             const unsigned char *is_free, double dt)
+{
+    double bound = 0; /* a maximum: the same at any thread count */
+#pragma omp parallel for schedule(static) reduction(max : bound)
+    for (int r = 0; r < s->nrows; r++) {
+        int i = s->row_particle[r];
+        if (!is_free[i])
+            continue;
+        double sum = 0;
+        for (int e = s->row_start[r]; e < s->row_start[r + 1]; e++)
+            sum += cs_spring_step_term(dt, s->row_stiffness[e] * s->row_inv_rest_length[e],
+                                       s->row_damping[e], s->row_magnitude[e]);
+        if (2.0 * sum / mass[i] > bound)
+            bound = 2.0 * sum / mass[i];
+    }
+    return bound;
+}
+
 void cs_springs_keep_touching(cs_springs *s, const int *owner, int rank)
 {
     int kept = 0, kept_edge = 0;

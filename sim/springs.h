@@ -10,6 +10,7 @@
 #ifndef CS_SPRINGS_H
 #define CS_SPRINGS_H
 
+#include <math.h>
 #include <stddef.h>
 
 typedef struct cs_springs {
@@ -91,5 +92,26 @@ double cs_springs_stiffness_bound(const cs_springs *s, const double *mass,
  * above is an upper one). Returns -1 when memory runs out. */
 double cs_springs_max_eigenvalue(const cs_springs *s, const double *x, const double *mass,
                                  const unsigned char *is_free, int n, int steps);
+
+/* The damped scheme's stability test (see step_limit.c). One spring of
+ * axial stiffness k = E / L0, damping c and tension stiffness g = E (1/L0 -
+ * 1/l) adds to its ends' rows of dt^2 K - 2 dt D a block of norm
+ * max(dt^2 k - 2 dt c, dt^2 |g|, 0): along the spring the damping offsets
+ * the stiffness, across it nothing damps the tension (or, for a compressed
+ * spring, the negative stiffness whose growth the step must not outrun). */
+static inline double cs_spring_step_term(double dt, double k, double c, double g)
+{
+    double along = dt * (dt * k - 2.0 * c), across = dt * dt * fabs(g);
+    return along > across ? (along > 0 ? along : 0) : (across > 0 ? across : 0);
+}
+/* Gershgorin's bound on the largest eigenvalue of M^-1 (dt^2 K - 2 dt D)
+ * at the rest state, over all springs and the free particles:
+ * max_i (2 / m_i) sum over i's springs of cs_spring_step_term. */
+double cs_springs_rest_step_bound(const cs_springs *s, const double *mass,
+                                  const unsigned char *is_free, int nparticles, double dt);
+/* The same over the rows (cs_springs_index) at the positions last given to
+ * cs_springs_prepare, tension included. */
+double cs_springs_step_bound(const cs_springs *s, const double *mass,
+                             const unsigned char *is_free, double dt);
 
 #endif
