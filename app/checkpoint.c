@@ -2,8 +2,8 @@
  * state hashes through xxHash (XXH3-128). */
 #include "app/checkpoint.h"
 
-#include "app/fsutil.h"
 #include "app/run.h"
+#include "common/util.h"
 
 #include <errno.h>
 #include <hdf5.h>

@@ -5,6 +5,8 @@
  */
 #include "app/intersections_cmd.h"
 
+#include "app/cli.h"
+
 #include "import/import.h"
 #include "sim/sim.h"
 
@@ -40,6 +42,9 @@ void cs_intersections_help(FILE *out)
           out);
 }
 
+/* A bad command line is exit status 2 here, with the whole help. */
+static const cs_cli CLI = {"intersections", NULL, cs_intersections_help, EXIT_BAD_INPUT};
+
 int cs_intersections_main(int argc, char **argv)
 {
     static const struct option longopts[] = {
@@ -60,17 +65,12 @@ int cs_intersections_main(int argc, char **argv)
             cs_intersections_help(stdout);
             return EXIT_CLEAN;
         default:
-            fprintf(stderr, "clothsim intersections: unknown option '%s'\n", argv[optind - 1]);
-            cs_intersections_help(stderr);
-            return EXIT_BAD_INPUT;
+            return cs_cli_option_error(&CLI, c, argv);
         }
     }
-    if (argc - optind != 1) {
-        fprintf(stderr, "clothsim intersections: %s\n",
-                argc - optind < 1 ? "no mesh file given" : "one mesh file at a time");
-        cs_intersections_help(stderr);
-        return EXIT_BAD_INPUT;
-    }
+    if (argc - optind != 1)
+        return cs_cli_error(&CLI, "%s",
+                            argc - optind < 1 ? "no mesh file given" : "one mesh file at a time");
     const char *path = argv[optind];
 
     char err[ERRLEN];

@@ -160,29 +160,30 @@ int cs_levelset_main(int argc, char **argv)
         fprintf(stderr, "clothsim levelset: warning: %s: %s\n", path, rep.size_warning);
     printf("mesh:      %s: %d triangles, %d vertices, %s", path, rep.triangles, rep.vertices,
            rep.closed ? "closed\n" : "open");
+    cs_mesh_report sign_rep;
+    int closed = 0;
+    cs_trimesh *sign = cs_mesh_body_sign_mesh(mesh, &rep, !keep_holes, &closed, &sign_rep);
+    if (!sign) {
+        fprintf(stderr, "clothsim levelset: out of memory\n");
+        cs_trimesh_destroy(mesh);
+        return CS_EXIT_OUTPUT;
+    }
+    if (sign != mesh) {
+        cs_trimesh_destroy(mesh);
+        mesh = sign;
+    }
     if (!rep.closed) {
         printf(" (%d boundary edges in %d loops)", rep.boundary_edges, rep.boundary_loops);
-        if (keep_holes) {
+        if (keep_holes)
             printf(": holes kept (--keep-holes); the sign may leak in through them\n");
-        } else {
-            int closed = cs_mesh_close_holes(&mesh);
-            if (closed < 0) {
-                fprintf(stderr, "clothsim levelset: out of memory\n");
-                cs_trimesh_destroy(mesh);
-                return CS_EXIT_OUTPUT;
-            }
-            cs_mesh_analyse(mesh, &rep);
+        else
             printf(": closed %d hole%s with fans%s\n", closed, closed == 1 ? "" : "s",
-                   rep.closed ? "" : " (still open: the sign may be wrong near what is left)");
-        }
+                   sign_rep.closed ? "" : " (still open: the sign may be wrong near what is left)");
     }
-    bool given = voxel > 0;
-    if (!given)
-        voxel = cs_levelset_default_voxel(&rep, 0, band, interior == CS_INTERIOR_FILL);
-    bool fill = interior == CS_INTERIOR_AUTO ? cs_levelset_auto_fill(&rep, voxel)
-                                             : interior == CS_INTERIOR_FILL;
+    rep = sign_rep;
+    bool given = voxel > 0, fill;
     char why[512];
-    if (!cs_levelset_voxel_ok(&rep, voxel, band, fill, why, sizeof why)) {
+    if (!cs_mesh_body_grid(&rep, &voxel, 0, band, interior, &fill, why, sizeof why)) {
         fprintf(stderr, "clothsim levelset: %s %g m: %s\n", given ? "--voxel" : "the default voxel",
                 voxel, why);
         cs_trimesh_destroy(mesh);

@@ -1,7 +1,7 @@
 /* lock.c: flock(2) on DIR/.lock, one run per output folder. */
 #include "app/lock.h"
 
-#include "app/fsutil.h"
+#include "common/util.h"
 
 #include <errno.h>
 #include <fcntl.h>

@@ -2,6 +2,8 @@
  * file: its nodes and meshes, and what a scene taking it (all of it, or one
  * node) gets: counts, bounds, units, repairs, topology, closedness. */
 #include "app/mesh_cmds.h"
+
+#include "app/cli.h"
 #include "app/run.h"
 #include "import/import.h"
 
@@ -34,6 +36,10 @@ void cs_mesh_info_help(FILE *out)
           "or holds no usable triangles.\n",
           out);
 }
+
+static const cs_cli CLI = {
+    "mesh-info", "usage: clothsim mesh-info FILE [--node NAME] [--units U] [--scale S]\n", NULL,
+    CS_EXIT_USAGE};
 
 /* --scale: a number > 0 */
 static int parse_scale(const char *s, double *out)
@@ -124,41 +130,27 @@ int cs_mesh_info_main(int argc, char **argv)
             place.node = optarg;
             break;
         case 'u':
-            if (!cs_mesh_units_from_name(optarg, &place.unit_scale)) {
-                fprintf(stderr, "clothsim mesh-info: --units: '%s' is not one of m, cm, mm, km, "
-                                "in, ft\n",
-                        optarg);
-                return CS_EXIT_USAGE;
-            }
+            if (!cs_mesh_units_from_name(optarg, &place.unit_scale))
+                return cs_cli_error(&CLI, "--units: '%s' is not one of m, cm, mm, km, in, ft",
+                                    optarg);
             break;
         case 's': {
             double v;
-            if (parse_scale(optarg, &v) != 0) {
-                fprintf(stderr, "clothsim mesh-info: --scale: '%s' is not a number > 0\n", optarg);
-                return CS_EXIT_USAGE;
-            }
+            if (parse_scale(optarg, &v) != 0)
+                return cs_cli_error(&CLI, "--scale: '%s' is not a number > 0", optarg);
             place.scale[0] = place.scale[1] = place.scale[2] = v;
             break;
         }
         case 'h':
             cs_mesh_info_help(stdout);
             return CS_EXIT_OK;
-        case ':':
-            fprintf(stderr, "clothsim mesh-info: option '%s' needs a value\n", argv[optind - 1]);
-            return CS_EXIT_USAGE;
         default:
-            fprintf(stderr, "clothsim mesh-info: unknown option '%s'\n"
-                            "usage: clothsim mesh-info FILE [--node NAME] [--units U] [--scale S]\n",
-                    argv[optind - 1]);
-            return CS_EXIT_USAGE;
+            return cs_cli_option_error(&CLI, c, argv);
         }
     }
-    if (argc - optind != 1) {
-        fprintf(stderr, "clothsim mesh-info: %s\nusage: clothsim mesh-info FILE [--node NAME] "
-                        "[--units U] [--scale S]\n",
-                argc - optind < 1 ? "no mesh file given" : "one mesh file at a time");
-        return CS_EXIT_USAGE;
-    }
+    if (argc - optind != 1)
+        return cs_cli_error(&CLI, "%s",
+                            argc - optind < 1 ? "no mesh file given" : "one mesh file at a time");
     const char *path = argv[optind];
     char err[1024];
     cs_mesh_catalog *cat = NULL;

@@ -2,8 +2,8 @@
  * run and continuing an earlier one. */
 #include "app/outdir.h"
 
-#include "app/fsutil.h"
 #include "app/run.h"
+#include "common/util.h"
 
 #include <dirent.h>
 #include <errno.h>
@@ -14,39 +14,155 @@
 #include <time.h>
 #include <unistd.h>
 
-static double monotonic_seconds(void)
+/* name with every character but letters, digits, '-', '_' and '.' as '_',
+ * into out (len > 0). */
+static void safe_name(const char *name, char *out, size_t len)
 {
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
-
-/* out/<scene name>, the name made safe for a path. */
-static char *default_dir(const char *scene_name)
-{
-    const char *name = scene_name && *scene_name ? scene_name : "scene";
-    size_t len = strlen(name);
-    char *dir = malloc(len + 5);
-    if (!dir)
-        return NULL;
-    memcpy(dir, "out/", 4);
-    for (size_t i = 0; i < len; i++) {
-        char ch = name[i];
+    size_t n = 0;
+    for (const char *s = name; *s && n + 1 < len; s++) {
+        char ch = *s;
         bool safe = (ch >= 'a' && ch <= 'z') || (ch >= 'A' && ch <= 'Z') ||
                     (ch >= '0' && ch <= '9') || ch == '-' || ch == '_' || ch == '.';
-        dir[4 + i] = safe ? ch : '_';
+        out[n++] = safe ? ch : '_';
     }
-    dir[4 + len] = '\0';
-    if (strcmp(dir, "out/.") == 0 || strcmp(dir, "out/..") == 0)
-        strcpy(dir, "out/scene");
-    return dir;
+    out[n] = '\0';
 }
+
+void cs_outdir_default(const char *scene_name, char *buf, size_t len)
+{
+    const char *name = scene_name && *scene_name ? scene_name : "scene";
+    if (strcmp(name, ".") == 0 || strcmp(name, "..") == 0)
+        name = "scene";
+    int n = snprintf(buf, len, "out/");
+    if (n > 0 && (size_t)n < len)
+        safe_name(name, buf + n, len - (size_t)n);
+}
+
+/* ---------------------------------------------------------------- frames */
+
+void cs_frame_path(char *buf, size_t len, const char *dir, int frame, const char *part,
+                   const char *ext)
+{
+    if (part)
+        snprintf(buf, len, "%s/frame_%04d.%s.%s", dir, frame, part, ext);
+    else
+        snprintf(buf, len, "%s/frame_%04d.%s", dir, frame, ext);
+}
+
+int cs_frame_layout_init(cs_frame_layout *l, cs_mesh_format format, int ncloths,
+                         const char *const *names)
+{
+    *l = (cs_frame_layout){format, ncloths, NULL, NULL};
+    l->names = calloc((size_t)ncloths + 1, sizeof *l->names);
+    if (!l->names)
+        return -1;
+    for (int c = 0; c < ncloths; c++) {
+        char fallback[32];
+        snprintf(fallback, sizeof fallback, "cloth_%d", c);
+        if (!(l->names[c] = strdup(names[c] && *names[c] ? names[c] : fallback))) {
+            cs_frame_layout_free(l);
+            return -1;
+        }
+    }
+    if (format != CS_MESH_PLY || ncloths < 2)
+        return 0; /* one file, a named object per cloth */
+    l->parts = calloc((size_t)ncloths, sizeof *l->parts);
+    if (!l->parts) {
+        cs_frame_layout_free(l);
+        return -1;
+    }
+    for (int c = 0; c < ncloths; c++) {
+        char part[256];
+        safe_name(l->names[c], part, sizeof part);
+        bool taken = !part[0] || strcmp(part, ".") == 0 || strcmp(part, "..") == 0;
+        for (int k = 0; k < c && !taken; k++)
+            taken = strcmp(l->parts[k], part) == 0;
+        if (taken)
+            snprintf(part, sizeof part, "cloth%d", c);
+        if (!(l->parts[c] = strdup(part))) {
+            cs_frame_layout_free(l);
+            return -1;
+        }
+    }
+    return 0;
+}
+
+void cs_frame_layout_free(cs_frame_layout *l)
+{
+    for (int c = 0; c < l->ncloths; c++) {
+        if (l->names)
+            free(l->names[c]);
+        if (l->parts)
+            free(l->parts[c]);
+    }
+    free(l->names);
+    free(l->parts);
+    l->names = l->parts = NULL;
+}
+
+void cs_frame_file_path(const cs_frame_layout *l, const char *dir, int frame, int c, char *buf,
+                        size_t len)
+{
+    cs_frame_path(buf, len, dir, frame, l->parts ? l->parts[c] : NULL,
+                  cs_mesh_format_extension(l->format));
+}
+
+int cs_frame_write(const cs_frame_layout *l, const char *frames_dir, int frame,
+                   cs_mesh_view *views, char *err, size_t errlen)
+{
+    char path[4096];
+    for (int c = 0; c < l->ncloths; c++)
+        views[c].name = l->names[c];
+    if (!l->parts) {
+        cs_frame_file_path(l, frames_dir, frame, 0, path, sizeof path);
+        return cs_mesh_write(path, l->format, l->ncloths, views, err, errlen);
+    }
+    int rc = CS_IMPORT_OK;
+    for (int c = 0; c < l->ncloths && rc == CS_IMPORT_OK; c++) {
+        cs_frame_file_path(l, frames_dir, frame, c, path, sizeof path);
+        rc = cs_mesh_write(path, l->format, 1, &views[c], err, errlen);
+    }
+    return rc;
+}
+
+int cs_frame_read(const cs_frame_layout *l, const char *frames_dir, int frame, cs_trimesh **out,
+                  char *err, size_t errlen)
+{
+    char path[4096];
+    int rc = CS_IMPORT_OK;
+    bool named = l->format != CS_MESH_PLY; /* else a file per cloth */
+    for (int c = 0; c < l->ncloths; c++)
+        out[c] = NULL;
+    for (int c = 0; c < (named ? 1 : l->ncloths) && rc == CS_IMPORT_OK; c++) {
+        cs_frame_file_path(l, frames_dir, frame, c, path, sizeof path);
+        if (access(path, F_OK) != 0) {
+            snprintf(err, errlen, "%s: no such frame file (%s)", path, strerror(errno));
+            rc = CS_IMPORT_BAD_INPUT;
+        } else if (!named) {
+            rc = (out[c] = cs_mesh_read(path, err, errlen)) ? CS_IMPORT_OK : CS_IMPORT_BAD_INPUT;
+        } else {
+            rc = cs_mesh_read_named(path, l->ncloths, (const char *const *)l->names, out, err,
+                                    errlen);
+        }
+    }
+    if (rc != CS_IMPORT_OK)
+        for (int c = 0; c < l->ncloths; c++) {
+            cs_trimesh_destroy(out[c]);
+            out[c] = NULL;
+        }
+    return rc == CS_IMPORT_OK ? CS_EXIT_OK : rc == CS_IMPORT_NOMEM ? CS_EXIT_OUTPUT
+                                                                   : CS_EXIT_INPUT;
+}
+
+/* ------------------------------------------------------------- the folder */
 
 int cs_outdir_init(cs_outdir *o, const char *dir, const char *scene_name)
 {
     memset(o, 0, sizeof *o);
     o->lock = CS_DIR_LOCK_NONE;
-    o->dir = dir ? strdup(dir) : default_dir(scene_name);
+    char fallback[4096];
+    cs_outdir_default(scene_name, fallback, sizeof fallback);
+    o->dir = strdup(dir ? dir : fallback);
     if (!o->dir)
         return -1;
     o->frames_dir = cs_path_join(o->dir, "frames");
@@ -59,6 +175,7 @@ int cs_outdir_init(cs_outdir *o, const char *dir, const char *scene_name)
 void cs_outdir_free(cs_outdir *o)
 {
     cs_dir_lock_release(&o->lock);
+    cs_frame_layout_free(&o->layout);
     free(o->dir);
     free(o->frames_dir);
     free(o->summary_path);
@@ -68,8 +185,8 @@ void cs_outdir_free(cs_outdir *o)
     o->lock = CS_DIR_LOCK_NONE;
 }
 
-/* "frame_<digits>.<ply|obj|glb>" with an optional ".tmp": its number in
- * *frame (a .tmp one as -1: always removed), or false. */
+/* "frame_<digits>[.<part>].<ply|obj|glb>" with an optional ".tmp": its
+ * number in *frame (a .tmp one as -1: always removed), or false. */
 static bool frame_file(const char *name, int *frame)
 {
     if (strncmp(name, "frame_", 6) != 0)
@@ -80,22 +197,20 @@ static bool frame_file(const char *name, int *frame)
     long n = 0;
     while (*s >= '0' && *s <= '9' && n < 100000000)
         n = 10 * n + (*s++ - '0');
-    if (*s++ != '.')
+    if (*s != '.')
         return false;
-    cs_mesh_format f;
+    size_t len = strlen(s);
+    bool tmp = len >= 4 && strcmp(s + len - 4, ".tmp") == 0;
+    if (tmp)
+        len -= 4;
+    if (len < 4 || s[len - 4] != '.')
+        return false;
     char ext[4];
-    if (strlen(s) < 3)
-        return false;
-    memcpy(ext, s, 3);
+    memcpy(ext, s + len - 3, 3);
     ext[3] = '\0';
-    if (!cs_mesh_format_from_name(ext, &f))
+    if (!cs_mesh_format_from_name(ext, NULL))
         return false;
-    if (s[3] == '\0')
-        *frame = (int)n;
-    else if (strcmp(s + 3, ".tmp") == 0)
-        *frame = -1;
-    else
-        return false;
+    *frame = tmp ? -1 : (int)n;
     return true;
 }
 
@@ -146,7 +261,7 @@ static int open_dir(cs_outdir *o, bool keep, char *err, size_t errlen)
     }
     if (cs_dir_lock_take(&o->lock, o->dir, err, errlen) != 0)
         return -1;
-    o->synced = monotonic_seconds();
+    o->synced = cs_now();
     if (keep)
         return 0;
     /* the state first: frames without it cannot be mistaken for a run to
@@ -164,7 +279,7 @@ static int open_dir(cs_outdir *o, bool keep, char *err, size_t errlen)
 }
 
 static int resume(cs_outdir *o, const cs_run_identity *id, cs_sim *sim, cs_summary *s,
-                  cs_mesh_format format, int frames, int *frame, char *err, size_t errlen)
+                  int frames, int *frame, char *err, size_t errlen)
 {
     double totals[CS_SUMMARY_TOTALS];
     int rc = cs_checkpoint_read(o->state_path, id, sim, frame, totals, err, errlen);
@@ -178,18 +293,19 @@ static int resume(cs_outdir *o, const cs_run_identity *id, cs_sim *sim, cs_summa
     /* frames written after the last state are made again, the same bits */
     if (remove_frames(o->frames_dir, *frame, err, errlen) != 0)
         return CS_EXIT_OUTPUT;
-    const char *ext = cs_mesh_format_extension(format);
-    for (int k = 0; k <= *frame; k++) {
-        char path[1024];
-        struct stat st;
-        snprintf(path, sizeof path, "%s/frame_%04d.%s", o->frames_dir, k, ext);
-        bool missing = stat(path, &st) != 0;
-        if (missing || st.st_size == 0) { /* empty: a power cut before it reached the disk */
-            snprintf(err, errlen, "cannot resume after frame %d: %.900s: %s", *frame, path,
-                     missing ? strerror(errno) : "empty");
-            return CS_EXIT_INPUT;
+    const cs_frame_layout *l = &o->layout;
+    for (int k = 0; k <= *frame; k++)
+        for (int c = 0; c < (l->parts ? l->ncloths : 1); c++) {
+            char path[1024];
+            struct stat st;
+            cs_frame_file_path(l, o->frames_dir, k, c, path, sizeof path);
+            bool missing = stat(path, &st) != 0;
+            if (missing || st.st_size == 0) { /* empty: a power cut before it reached the disk */
+                snprintf(err, errlen, "cannot resume after frame %d: %.900s: %s", *frame, path,
+                         missing ? strerror(errno) : "empty");
+                return CS_EXIT_INPUT;
+            }
         }
-    }
     if (cs_summary_open_records(s, o->records_path, *frame, err, errlen) != 0)
         return CS_EXIT_OUTPUT;
     cs_summary_set_base(s, totals);
@@ -199,8 +315,7 @@ static int resume(cs_outdir *o, const cs_run_identity *id, cs_sim *sim, cs_summa
 }
 
 int cs_outdir_start(cs_outdir *o, bool resuming, bool quiet, const cs_run_identity *id,
-                    cs_sim *sim, cs_summary *s, cs_mesh_format format, int frames,
-                    int *first_frame)
+                    cs_sim *sim, cs_summary *s, int frames, int *first_frame)
 {
     char err[1024];
     int status = CS_EXIT_OK;
@@ -208,7 +323,7 @@ int cs_outdir_start(cs_outdir *o, bool resuming, bool quiet, const cs_run_identi
     if (open_dir(o, resuming, err, sizeof err) != 0)
         status = CS_EXIT_OUTPUT;
     else if (resuming)
-        status = resume(o, id, sim, s, format, frames, first_frame, err, sizeof err);
+        status = resume(o, id, sim, s, frames, first_frame, err, sizeof err);
     else if (cs_summary_open_records(s, o->records_path, 0, err, sizeof err) != 0)
         status = CS_EXIT_OUTPUT;
     if (status != CS_EXIT_OK)
@@ -230,7 +345,7 @@ int cs_outdir_save_state(cs_outdir *o, const cs_run_identity *id, int frame,
 
 int cs_outdir_sync(cs_outdir *o, bool now, char *err, size_t errlen)
 {
-    double t = monotonic_seconds();
+    double t = cs_now();
     if (!now && t - o->synced < CS_OUTDIR_SYNC_SECONDS)
         return 0;
     o->synced = t;

@@ -1,11 +1,22 @@
-/* outdir.h: the folder a `clothsim run` writes, DIR:
+/* outdir.h: the run folder: the one module that knows the layout of the
+ * folder a `clothsim run` writes, DIR, and reads it back (`clothsim render`):
  *   DIR/frames/frame_NNNN.EXT   a mesh per frame, frame 0 the initial state
+ *                               (frame naming, cs_frame_path: also the
+ *                               images, DIR/images/frame_NNNN.png)
  *   DIR/frames.jsonl            a record per simulated frame, one JSON a line
  *   DIR/summary.json            the run as a whole (summary.h)
  *   DIR/state.h5                what --resume continues from (checkpoint.h)
  *   DIR/.lock                   held while a run writes (lock.h)
  * A new run takes the folder over: frames, records and state of an earlier
- * run there are removed. --resume continues the earlier run instead. */
+ * run there are removed. --resume continues the earlier run instead.
+ *
+ * A frame keeps its cloths apart, so that they read back by name: in OBJ
+ * and glTF each cloth is an object of its own (a node and a mesh named like
+ * the cloth); PLY has no objects, so a scene of several cloths writes a
+ * file per cloth, frame_NNNN.NAME.ply, NAME the cloth's name made safe for
+ * a path (letters, digits, '-', '_' and '.' kept, others '_'; a name taken
+ * by an earlier cloth becomes clothK, K its index). Every file is written
+ * atomically (common/util.h). */
 #ifndef CS_APP_OUTDIR_H
 #define CS_APP_OUTDIR_H
 
@@ -17,8 +28,45 @@
 #include "app/summary.h"
 #include "import/import.h"
 
+/* "dir/frame_NNNN.ext", or with part "dir/frame_NNNN.part.ext", in buf. */
+void cs_frame_path(char *buf, size_t len, const char *dir, int frame, const char *part,
+                   const char *ext);
+
+/* How a run's frames hold its cloths. */
+typedef struct cs_frame_layout {
+    cs_mesh_format format;
+    int ncloths;
+    char **names;              /* per cloth its object's name */
+    char **parts;              /* per cloth its file's part (PLY, several cloths), else NULL */
+} cs_frame_layout;
+
+/* The layout of ncloths cloths named names[c] (a cloth without a name is
+ * cloth_C). Returns 0, or -1 when memory runs out. */
+int cs_frame_layout_init(cs_frame_layout *l, cs_mesh_format format, int ncloths,
+                         const char *const *names);
+void cs_frame_layout_free(cs_frame_layout *l);
+
+/* Writes frame's files into frames_dir: views[c] is cloth c (its name
+ * from the layout). Returns a CS_IMPORT_* status with err. */
+int cs_frame_write(const cs_frame_layout *l, const char *frames_dir, int frame,
+                   cs_mesh_view *views, char *err, size_t errlen);
+
+/* The path of the file of frame that holds cloth c, in buf. */
+void cs_frame_file_path(const cs_frame_layout *l, const char *dir, int frame, int c, char *buf,
+                        size_t len);
+
+/* Reads frame's cloths by name into out[c] (the caller destroys them).
+ * Returns an exit status (CS_EXIT_INPUT: a file missing or unreadable, or
+ * without an object of a cloth's name) with err. */
+int cs_frame_read(const cs_frame_layout *l, const char *frames_dir, int frame, cs_trimesh **out,
+                  char *err, size_t errlen);
+
+/* out/<scene name>, the name made safe for a path, in buf. */
+void cs_outdir_default(const char *scene_name, char *buf, size_t len);
+
 typedef struct cs_outdir {
     char *dir, *frames_dir, *summary_path, *records_path, *state_path;
+    cs_frame_layout layout;  /* the frames' files (cs_frame_layout_init before starting) */
     cs_dir_lock lock;
     double synced;  /* when cs_outdir_sync last reached the disk (monotonic s) */
 } cs_outdir;
@@ -29,7 +77,7 @@ typedef struct cs_outdir {
 /* The paths of dir, or when dir is NULL of out/<scene name> (made safe for
  * a path); returns 0, or -1 when memory runs out. */
 int cs_outdir_init(cs_outdir *o, const char *dir, const char *scene_name);
-/* Frees the paths and releases the lock. */
+/* Frees the paths and the layout, and releases the lock. */
 void cs_outdir_free(cs_outdir *o);
 
 /* Rank 0, before the run writes: makes the folders and takes the lock;
@@ -41,8 +89,7 @@ void cs_outdir_free(cs_outdir *o);
  * frames: the frames asked for now. Says what is wrong, or that it resumes
  * (unless quiet), on stderr. Returns an exit status. */
 int cs_outdir_start(cs_outdir *o, bool resume, bool quiet, const cs_run_identity *id,
-                    cs_sim *sim, cs_summary *s, cs_mesh_format format, int frames,
-                    int *first_frame);
+                    cs_sim *sim, cs_summary *s, int frames, int *first_frame);
 
 /* Rank 0, after frame (after cs_sim_state_gather): DIR/state.h5 for it,
  * with the summary's totals. Returns 0, or -1 with err. */

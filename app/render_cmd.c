@@ -4,19 +4,19 @@
  *
  * A run folder names its scene file and the --set overrides it ran with in
  * summary.json, so the scene is reloaded exactly: cloth colours, bodies
- * and their motion, the camera. A frame file holds every cloth merged, one
- * after the other in scene order, and reading it joins identical vertices;
- * OBJ also renumbers them. So a frame is split back into cloths by the
- * scene's triangle counts, each cloth taking its own triangles and the
- * vertices they use, whatever their order. When the counts disagree the
- * frame is drawn as one mesh in the first cloth's colour, and the command
- * says so once.
+ * and their motion, the camera. A frame keeps its cloths apart (outdir.h:
+ * an object per cloth in OBJ and glTF, a file per cloth in PLY), so each is
+ * read back by its name. A frame without them (written before frames kept
+ * cloths apart, or the scene's cloths renamed since) is drawn as one mesh
+ * in the first cloth's colour, and the command says so once.
  */
-#include "app/fsutil.h"
 #include "app/render_cmd.h"
 
+#include "app/cli.h"
+#include "app/outdir.h"
 #include "app/run.h"
 #include "app/scene_render.h"
+#include "common/util.h"
 #include "import/import.h"
 #include "render/render.h"
 #include "sim/sim.h"
@@ -80,15 +80,13 @@ void cs_render_help(FILE *out)
         out);
 }
 
-static void usage_error(const char *fmt, const char *arg)
-{
-    fprintf(stderr, "clothsim render: ");
-    fprintf(stderr, fmt, arg);
-    fprintf(stderr, "\nusage: clothsim render (RUN_DIR | SCENE) [-o DIR] [--engine embree|preview]\n"
-                    "                       [--frames LIST] [--size WxH] [--samples N]\n"
-                    "                       [--turntable N] [--set KEY=VALUE]...\n"
-                    "'clothsim render --help' explains every option.\n");
-}
+static const cs_cli CLI = {
+    "render",
+    "usage: clothsim render (RUN_DIR | SCENE) [-o DIR] [--engine embree|preview]\n"
+    "                       [--frames LIST] [--size WxH] [--samples N]\n"
+    "                       [--turntable N] [--set KEY=VALUE]...\n"
+    "'clothsim render --help' explains every option.\n",
+    NULL, CS_EXIT_USAGE};
 
 typedef struct render_options {
     const char *target;
@@ -102,6 +100,14 @@ typedef struct render_options {
     char **overrides;
     bool quiet;
 } render_options;
+
+/* A value cs_parse_size or cs_parse_count refused: 1 not of the form
+ * asked for (a bad command line), 2 out of range (bad input). */
+static int value_error(int rc, const char *err)
+{
+    fprintf(stderr, "clothsim render: %s\n", err);
+    return rc == 1 ? CS_EXIT_USAGE : CS_EXIT_INPUT;
+}
 
 enum {
     OPT_FRAMES = 256, OPT_SIZE, OPT_SAMPLES, OPT_BOUNCES, OPT_THREADS, OPT_FLAT,
@@ -143,49 +149,37 @@ static int parse_options(int argc, char **argv, render_options *o)
     while ((c = getopt_long(argc, argv, ":o:e:qh", longopts, NULL)) != -1) {
         switch (c) {
         case 'o':
-            if (!*optarg) {
-                usage_error("%s", "--output needs a directory name");
-                return CS_EXIT_USAGE;
-            }
+            if (!*optarg)
+                return cs_cli_error(&CLI, "%s", "--output needs a directory name");
             o->out_dir = optarg;
             break;
         case 'e':
-            if (!cs_render_engine_from_name(optarg, &o->settings.engine)) {
-                usage_error("--engine: '%s' is not one of embree, preview", optarg);
-                return CS_EXIT_USAGE;
-            }
+            if (!cs_render_engine_from_name(optarg, &o->settings.engine))
+                return cs_cli_error(&CLI, "--engine: '%s' is not one of embree, preview", optarg);
             break;
         case OPT_FRAMES:
             o->frames = optarg;
             break;
         case OPT_SIZE:
             if ((rc = cs_parse_size(optarg, &o->settings.width, &o->settings.height, err,
-                                    sizeof err))) {
-                fprintf(stderr, "clothsim render: %s\n", err);
-                return rc == 1 ? CS_EXIT_USAGE : CS_EXIT_INPUT;
-            }
+                                    sizeof err)))
+                return value_error(rc, err);
             break;
         case OPT_SAMPLES:
             if ((rc = cs_parse_count(optarg, "--samples", 1, CS_RENDER_MAX_SAMPLES,
-                                     &o->settings.samples, err, sizeof err))) {
-                fprintf(stderr, "clothsim render: %s\n", err);
-                return rc == 1 ? CS_EXIT_USAGE : CS_EXIT_INPUT;
-            }
+                                     &o->settings.samples, err, sizeof err)))
+                return value_error(rc, err);
             o->samples_given = true;
             break;
         case OPT_BOUNCES:
             if ((rc = cs_parse_count(optarg, "--bounces", 0, 16, &o->settings.bounces, err,
-                                     sizeof err))) {
-                fprintf(stderr, "clothsim render: %s\n", err);
-                return rc == 1 ? CS_EXIT_USAGE : CS_EXIT_INPUT;
-            }
+                                     sizeof err)))
+                return value_error(rc, err);
             break;
         case OPT_THREADS:
             if ((rc = cs_parse_count(optarg, "--threads", 0, 1024, &o->settings.threads, err,
-                                     sizeof err))) {
-                fprintf(stderr, "clothsim render: %s\n", err);
-                return rc == 1 ? CS_EXIT_USAGE : CS_EXIT_INPUT;
-            }
+                                     sizeof err)))
+                return value_error(rc, err);
             break;
         case OPT_FLAT:
             o->settings.flat = true;
@@ -195,16 +189,12 @@ static int parse_options(int argc, char **argv, render_options *o)
             break;
         case OPT_TURNTABLE:
             if ((rc = cs_parse_count(optarg, "--turntable", 1, MAX_TURNTABLE, &o->turntable,
-                                     err, sizeof err))) {
-                fprintf(stderr, "clothsim render: %s\n", err);
-                return rc == 1 ? CS_EXIT_USAGE : CS_EXIT_INPUT;
-            }
+                                     err, sizeof err)))
+                return value_error(rc, err);
             break;
         case OPT_SET:
-            if (!strchr(optarg, '=') || optarg[0] == '=') {
-                usage_error("--set needs KEY=VALUE, got '%s'", optarg);
-                return CS_EXIT_USAGE;
-            }
+            if (!strchr(optarg, '=') || optarg[0] == '=')
+                return cs_cli_error(&CLI, "--set needs KEY=VALUE, got '%s'", optarg);
             o->overrides[o->noverrides++] = optarg;
             break;
         case OPT_SCENE:
@@ -216,146 +206,20 @@ static int parse_options(int argc, char **argv, render_options *o)
         case 'h':
             cs_render_help(stdout);
             return CS_EXIT_OK;
-        case ':':
-            usage_error("option '%s' needs a value", argv[optind - 1]);
-            return CS_EXIT_USAGE;
-        default: {
-            const char *arg = argv[optind - 1];
-            char shortopt[3] = {'-', (char)optopt, '\0'};
-            if (strncmp(arg, "--", 2) != 0 && optopt > ' ' && optopt < 127)
-                arg = shortopt;
-            usage_error("unknown option '%s'", arg);
-            return CS_EXIT_USAGE;
-        }
+        default:
+            return cs_cli_option_error(&CLI, c, argv);
         }
     }
-    if (optind >= argc) {
-        usage_error("%s", "no run folder or scene file given");
-        return CS_EXIT_USAGE;
-    }
+    if (optind >= argc)
+        return cs_cli_error(&CLI, "%s", "no run folder or scene file given");
     if (argc - optind > 1) {
-        usage_error("one run folder or scene file only; '%s' is one too many", argv[optind + 1]);
-        return CS_EXIT_USAGE;
+        return cs_cli_error(&CLI, "one run folder or scene file only; '%s' is one too many",
+                            argv[optind + 1]);
     }
     o->target = argv[optind];
     if (o->settings.engine == CS_RENDER_PREVIEW && !o->samples_given)
         o->settings.samples = 4;
     return -1;
-}
-
-/* ------------------------------------------------------------ run folder */
-
-typedef struct run_info {
-    char *scene_file;
-    int noverrides;
-    char **overrides;
-    char format[8];
-    int frames_written;
-    double fps;
-} run_info;
-
-static void run_info_free(run_info *r)
-{
-    free(r->scene_file);
-    for (int i = 0; i < r->noverrides; i++)
-        free(r->overrides[i]);
-    free(r->overrides);
-}
-
-static char *read_text(const char *path, char *err, size_t errlen)
-{
-    FILE *fp = fopen(path, "rb");
-    if (!fp) {
-        snprintf(err, errlen, "cannot read %s: %s", path, strerror(errno));
-        return NULL;
-    }
-    size_t cap = 4096, len = 0;
-    char *text = malloc(cap);
-    while (text) {
-        size_t n = fread(text + len, 1, cap - len - 1, fp);
-        len += n;
-        if (len + 1 < cap)
-            break;
-        char *grown = cap < (64u << 20) ? realloc(text, cap * 2) : NULL;
-        if (!grown) {
-            free(text);
-            text = NULL;
-            break;
-        }
-        text = grown;
-        cap *= 2;
-    }
-    fclose(fp);
-    if (!text)
-        snprintf(err, errlen, "cannot read %s: too large or out of memory", path);
-    else
-        text[len] = '\0';
-    return text;
-}
-
-/* Reads DIR/summary.json; returns 0 or an exit status with err. */
-static int read_run_info(const char *dir, run_info *info, char *err, size_t errlen)
-{
-    memset(info, 0, sizeof *info);
-    char path[4096];
-    snprintf(path, sizeof path, "%s/summary.json", dir);
-    if (access(path, F_OK) != 0) {
-        snprintf(err, errlen,
-                 "%s has no summary.json: give the output folder of 'clothsim run' or a "
-                 "scene file",
-                 dir);
-        return CS_EXIT_INPUT;
-    }
-    char *text = read_text(path, err, errlen);
-    if (!text)
-        return CS_EXIT_INPUT;
-    cJSON *root = cJSON_Parse(text);
-    free(text);
-    const cJSON *scene = root ? cJSON_GetObjectItemCaseSensitive(root, "scene_file") : NULL;
-    const cJSON *format = root ? cJSON_GetObjectItemCaseSensitive(root, "format") : NULL;
-    const cJSON *written = root ? cJSON_GetObjectItemCaseSensitive(root, "frames_written") : NULL;
-    const cJSON *fps = root ? cJSON_GetObjectItemCaseSensitive(root, "fps") : NULL;
-    const cJSON *over = root ? cJSON_GetObjectItemCaseSensitive(root, "overrides") : NULL;
-    cs_mesh_format f;
-    if (!cJSON_IsString(scene) || !cJSON_IsString(format) || !cJSON_IsNumber(written) ||
-        !cJSON_IsNumber(fps) || !cs_mesh_format_from_name(format->valuestring, &f) ||
-        strlen(format->valuestring) >= sizeof info->format || (over && !cJSON_IsArray(over))) {
-        snprintf(err, errlen,
-                 "%s: not a summary written by 'clothsim run' (needs scene_file, format, "
-                 "frames_written, fps)",
-                 path);
-        cJSON_Delete(root);
-        return CS_EXIT_INPUT;
-    }
-    info->scene_file = strdup(scene->valuestring);
-    snprintf(info->format, sizeof info->format, "%s", cs_mesh_format_extension(f));
-    info->frames_written = written->valuedouble > 0 && written->valuedouble < 1e8
-                               ? (int)written->valuedouble
-                               : 0;
-    info->fps = fps->valuedouble;
-    int n = over ? cJSON_GetArraySize(over) : 0;
-    info->overrides = calloc((size_t)n + 1, sizeof *info->overrides);
-    bool ok = info->scene_file && info->overrides;
-    const cJSON *item;
-    if (ok && over)
-        cJSON_ArrayForEach(item, over) {
-            if (!cJSON_IsString(item)) {
-                snprintf(err, errlen, "%s: \"overrides\" must be a list of strings", path);
-                cJSON_Delete(root);
-                return CS_EXIT_INPUT;
-            }
-            if (!(info->overrides[info->noverrides] = strdup(item->valuestring))) {
-                ok = false;
-                break;
-            }
-            info->noverrides++;
-        }
-    cJSON_Delete(root);
-    if (!ok) {
-        snprintf(err, errlen, "out of memory");
-        return CS_EXIT_OUTPUT;
-    }
-    return CS_EXIT_OK;
 }
 
 /* ------------------------------------------------------------ frame list */
@@ -447,107 +311,25 @@ static int parse_frames(const char *list, int n, int **out, int *count, char *er
     return CS_EXIT_OK;
 }
 
-/* ------------------------------------------------------------------ utils */
+/* ---------------------------------------------------------------- frames */
 
-/* out/<scene name>, the name made safe for a path (as `clothsim run`). */
-static void scene_out_dir(const char *name, char *out, size_t len)
-{
-    if (!name || !*name || strcmp(name, ".") == 0 || strcmp(name, "..") == 0)
-        name = "scene";
-    size_t n = snprintf(out, len, "out/");
-    for (const char *s = name; *s && n + 1 < len; s++) {
-        char ch = *s;
-        bool safe = (ch >= 'a' && ch <= 'z') || (ch >= 'A' && ch <= 'Z') ||
-                    (ch >= '0' && ch <= '9') || ch == '-' || ch == '_' || ch == '.';
-        out[n++] = safe ? ch : '_';
-    }
-    out[n] = '\0';
-}
-
-/* The cloths of one frame, split back into the scene's cloths. */
+/* The cloths of one frame, read by name. */
 typedef struct frame_geometry {
-    cs_trimesh *file;          /* what the frame file held */
-    cs_trimesh **parts;        /* per cloth: its triangles of the file */
+    cs_frame_layout layout;    /* how the run's frames hold the scene's cloths */
+    cs_trimesh **meshes;       /* per cloth: its mesh of the file */
+    cs_trimesh *file;          /* a file without the cloths' objects, merged */
     const double **x;          /* scene file: per cloth, the scene's positions */
     cs_frame_cloths cloths;
 } frame_geometry;
 
-static void frame_geometry_clear(frame_geometry *g, int ncloths)
+static void frame_geometry_clear(frame_geometry *g)
 {
     cs_trimesh_destroy(g->file);
     g->file = NULL;
-    for (int c = 0; g->parts && c < ncloths; c++) {
-        cs_trimesh_destroy(g->parts[c]);
-        g->parts[c] = NULL;
+    for (int c = 0; g->meshes && c < g->layout.ncloths; c++) {
+        cs_trimesh_destroy(g->meshes[c]);
+        g->meshes[c] = NULL;
     }
-}
-
-/* Cloth c is the file's triangles [first, first + scene nt_c), with the
- * vertices they use renumbered from 0. Returns false when memory runs out. */
-static bool split_by_triangles(const cs_scene *scene, frame_geometry *g)
-{
-    const cs_trimesh *f = g->file;
-    int *map = malloc(((size_t)f->nv + 1) * sizeof *map);
-    if (!map)
-        return false;
-    for (int v = 0; v < f->nv; v++)
-        map[v] = -1;
-    int first = 0;
-    bool ok = true;
-    for (int c = 0; c < scene->def.ncloths && ok; c++) {
-        int nt = scene->def.cloths[c].mesh->nt, nv = 0;
-        const int *tri = f->tri + 3 * (size_t)first;
-        for (int k = 0; k < 3 * nt; k++)
-            if (map[tri[k]] < 0)
-                map[tri[k]] = nv++;
-        cs_trimesh *part = cs_trimesh_create(nv, nt);
-        if (!part) {
-            ok = false;
-        } else {
-            for (int k = 0; k < 3 * nt; k++) {
-                int v = map[tri[k]];
-                part->tri[k] = v;
-                memcpy(part->x + 3 * (size_t)v, f->x + 3 * (size_t)tri[k], 3 * sizeof *part->x);
-            }
-            g->parts[c] = part;
-        }
-        for (int k = 0; k < 3 * nt; k++)
-            map[tri[k]] = -1;
-        first += nt;
-    }
-    free(map);
-    return ok;
-}
-
-/* Reads a run's frame. Returns 0 or an exit status with err; *merged is set
- * when the file has to be drawn as one mesh. */
-static int load_frame(const cs_scene *scene, const char *dir, const run_info *info, int frame,
-                      frame_geometry *g, bool *merged, char *err, size_t errlen)
-{
-    char path[4096], msg[ERRLEN];
-    snprintf(path, sizeof path, "%s/frames/frame_%04d.%s", dir, frame, info->format);
-    if (access(path, F_OK) != 0) {
-        snprintf(err, errlen, "%s: no such frame file (%s)", path, strerror(errno));
-        return CS_EXIT_INPUT;
-    }
-    g->file = cs_mesh_read(path, msg, sizeof msg);
-    if (!g->file) {
-        snprintf(err, errlen, "%s", msg);
-        return CS_EXIT_INPUT;
-    }
-    long total = 0;
-    for (int c = 0; c < scene->def.ncloths; c++)
-        total += scene->def.cloths[c].mesh->nt;
-    *merged = total != g->file->nt;
-    g->cloths = (cs_frame_cloths){.merged = g->file};
-    if (!*merged) {
-        if (!split_by_triangles(scene, g)) {
-            snprintf(err, errlen, "out of memory splitting %s into cloths", path);
-            return CS_EXIT_OUTPUT;
-        }
-        g->cloths = (cs_frame_cloths){.meshes = (const cs_trimesh *const *)g->parts};
-    }
-    return CS_EXIT_OK;
 }
 
 /* ------------------------------------------------------------------ main */
@@ -556,8 +338,9 @@ typedef struct job {
     render_options *o;
     const cs_scene *scene;
     bool run_mode;
-    run_info info;
+    cs_run_info info;
     double fps;
+    char frames_dir[4096];
     char out_dir[4096];
     cs_scene_render *sr;
     cs_image *image;
@@ -565,29 +348,35 @@ typedef struct job {
     bool merged_said;
 } job;
 
-/* Loads the geometry of frame f into j->geom. */
+/* Loads the geometry of frame f into j->geom: per cloth its object of the
+ * frame, read by name; a file without them (an older run's, or a scene
+ * changed since) is drawn as one mesh in the first cloth's colour, as the
+ * command says once. */
 static int get_frame(job *j, int f, char *err, size_t errlen)
 {
-    frame_geometry_clear(&j->geom, j->scene->def.ncloths);
+    frame_geometry *g = &j->geom;
+    frame_geometry_clear(g);
     if (!j->run_mode) {
         for (int c = 0; c < j->scene->def.ncloths; c++)
-            j->geom.x[c] = j->scene->def.cloths[c].mesh->x;
-        j->geom.cloths = (cs_frame_cloths){.x = j->geom.x};
+            g->x[c] = j->scene->def.cloths[c].mesh->x;
+        g->cloths = (cs_frame_cloths){.x = g->x};
         return CS_EXIT_OK;
     }
-    bool merged = false;
-    int status = load_frame(j->scene, j->o->target, &j->info, f, &j->geom, &merged, err, errlen);
-    if (status == CS_EXIT_OK && merged && !j->merged_said && !j->o->quiet) {
-        long total = 0;
-        for (int c = 0; c < j->scene->def.ncloths; c++)
-            total += j->scene->def.cloths[c].mesh->nt;
-        fprintf(stderr,
-                "clothsim render: frame %d holds %d triangles, the scene's cloths %ld: all "
-                "cloth is drawn as one mesh in the first cloth's colour\n",
-                f, j->geom.file->nt, total);
-        j->merged_said = true;
-    }
-    return status;
+    int status = cs_frame_read(&g->layout, j->frames_dir, f, g->meshes, err, errlen);
+    g->cloths = (cs_frame_cloths){.meshes = (const cs_trimesh *const *)g->meshes};
+    if (status != CS_EXIT_INPUT || g->layout.format == CS_MESH_PLY)
+        return status;
+    char path[4096], why[ERRLEN];
+    cs_frame_file_path(&g->layout, j->frames_dir, f, 0, path, sizeof path);
+    snprintf(why, sizeof why, "%s", err);
+    if (access(path, F_OK) != 0 || !(g->file = cs_mesh_read(path, err, errlen)))
+        return CS_EXIT_INPUT;
+    g->cloths = (cs_frame_cloths){.merged = g->file};
+    if (!j->merged_said && !j->o->quiet)
+        fprintf(stderr, "clothsim render: %s: all cloth is drawn as one mesh in the first "
+                        "cloth's colour\n", why);
+    j->merged_said = true;
+    return CS_EXIT_OK;
 }
 
 static int render_frames(job *j, const int *frames, int nframes)
@@ -605,7 +394,7 @@ static int render_frames(job *j, const int *frames, int nframes)
             return status;
         }
         char path[4200];
-        snprintf(path, sizeof path, "%s/frame_%04d.png", j->out_dir, f);
+        cs_frame_path(path, sizeof path, j->out_dir, f, NULL, "png");
         if (cs_image_write_png(j->image, path, err, sizeof err) != CS_RENDER_OK) {
             fprintf(stderr, "clothsim render: %s\n", err);
             return CS_EXIT_OUTPUT;
@@ -753,14 +542,14 @@ int cs_render_main(int argc, char **argv)
     j.run_mode = S_ISDIR(st.st_mode);
     const char *scene_path = o.target;
     if (j.run_mode) {
-        if ((status = read_run_info(o.target, &j.info, err, sizeof err)) != CS_EXIT_OK) {
+        if ((status = cs_run_info_read(o.target, &j.info, err, sizeof err)) != CS_EXIT_OK) {
             fprintf(stderr, "clothsim render: %s\n", err);
             goto done;
         }
         scene_path = o.scene_path ? o.scene_path : j.info.scene_file;
     } else if (o.scene_path) {
-        usage_error("%s", "--scene is for a run folder; TARGET is already a scene file");
-        status = CS_EXIT_USAGE;
+        status = cs_cli_error(&CLI, "%s",
+                              "--scene is for a run folder; TARGET is already a scene file");
         goto done;
     }
 
@@ -801,14 +590,14 @@ int cs_render_main(int argc, char **argv)
             fprintf(stderr, "clothsim render: --frames %s: %s is a scene file, which has only "
                             "its initial state, frame 0\n", list, o.target);
         else if (status == CS_EXIT_USAGE)
-            usage_error("%s", err);
+            cs_cli_error(&CLI, "%s", err);
         else
             fprintf(stderr, "clothsim render: %s\n", err);
         goto done;
     }
     if (o.turntable && nframes != 1) {
-        usage_error("%s", "--turntable renders one frame: give --frames N (or last)");
-        status = CS_EXIT_USAGE;
+        status = cs_cli_error(&CLI, "%s",
+                              "--turntable renders one frame: give --frames N (or last)");
         goto done;
     }
 
@@ -820,7 +609,7 @@ int cs_render_main(int argc, char **argv)
         snprintf(j.out_dir, sizeof j.out_dir, "%s/%s", o.target, leaf);
     else {
         char base[2048];
-        scene_out_dir(scene->name, base, sizeof base);
+        cs_outdir_default(scene->name, base, sizeof base);
         snprintf(j.out_dir, sizeof j.out_dir, "%s/%s", base, leaf);
     }
 
@@ -831,9 +620,17 @@ int cs_render_main(int argc, char **argv)
         goto done;
     }
     j.image = cs_image_create(o.settings.width, o.settings.height);
-    j.geom.x = calloc((size_t)scene->def.ncloths + 1, sizeof *j.geom.x);
-    j.geom.parts = calloc((size_t)scene->def.ncloths + 1, sizeof *j.geom.parts);
-    if (!j.image || !j.geom.x || !j.geom.parts) {
+    int ncloths = scene->def.ncloths;
+    j.geom.x = calloc((size_t)ncloths + 1, sizeof *j.geom.x);
+    j.geom.meshes = calloc((size_t)ncloths + 1, sizeof *j.geom.meshes);
+    const char **names = calloc((size_t)ncloths + 1, sizeof *names);
+    for (int c = 0; names && c < ncloths; c++)
+        names[c] = scene->def.cloths[c].name;
+    bool ok = names && (!j.run_mode || cs_frame_layout_init(&j.geom.layout, j.info.format,
+                                                            ncloths, names) == 0);
+    free(names);
+    snprintf(j.frames_dir, sizeof j.frames_dir, "%s/frames", o.target);
+    if (!j.image || !j.geom.x || !j.geom.meshes || !ok) {
         fprintf(stderr, "clothsim render: out of memory for a %dx%d image\n", o.settings.width,
                 o.settings.height);
         status = CS_EXIT_OUTPUT;
@@ -847,9 +644,9 @@ int cs_render_main(int argc, char **argv)
     status = o.turntable ? render_turntable(&j, frames[0]) : render_frames(&j, frames, nframes);
 
 done:
-    if (scene)
-        frame_geometry_clear(&j.geom, scene->def.ncloths);
-    free(j.geom.parts);
+    frame_geometry_clear(&j.geom);
+    cs_frame_layout_free(&j.geom.layout);
+    free(j.geom.meshes);
     free(j.geom.x);
     cs_image_destroy(j.image);
     cs_scene_render_destroy(j.sr);
@@ -857,7 +654,7 @@ done:
         cs_scene_destroy(scene);
     free(frames);
     free(all_overrides);
-    run_info_free(&j.info);
+    cs_run_info_free(&j.info);
     free(o.overrides);
     return status;
 }

@@ -8,14 +8,15 @@
  * (instability, a signal, a full disk) leaves complete frames and a summary
  * that describes exactly them.
  */
-#include "app/fsutil.h"
 #include "app/run.h"
 
 #include "app/checkpoint.h"
+#include "app/cli.h"
 #include "app/outdir.h"
 #include "app/progress.h"
 #include "app/scene_render.h"
 #include "app/summary.h"
+#include "common/util.h"
 #include "import/import.h"
 #include "sim/sim.h"
 
@@ -116,14 +117,12 @@ void cs_run_help(FILE *out)
         out);
 }
 
-static void usage_error(const char *fmt, const char *arg)
-{
-    fprintf(stderr, "clothsim run: ");
-    fprintf(stderr, fmt, arg);
-    fprintf(stderr, "\nusage: clothsim run SCENE [-o DIR] [--set KEY=VALUE]... [--format ply|obj|glb]\n"
-                    "                    [--frames N] [--threads N] [--plan] [--resume] [--quiet]\n"
-                    "'clothsim run --help' explains every option.\n");
-}
+static const cs_cli CLI = {
+    "run",
+    "usage: clothsim run SCENE [-o DIR] [--set KEY=VALUE]... [--format ply|obj|glb]\n"
+    "                    [--frames N] [--threads N] [--plan] [--resume] [--quiet]\n"
+    "'clothsim run --help' explains every option.\n",
+    NULL, CS_EXIT_USAGE};
 
 enum { OPT_SET = 256, OPT_FORMAT, OPT_FRAMES, OPT_PLAN, OPT_RENDER, OPT_SIZE, OPT_SAMPLES,
        OPT_THREADS, OPT_RESUME };
@@ -174,38 +173,31 @@ static int parse_options(int argc, char **argv, run_options *o)
     while ((c = getopt_long(argc, argv, ":o:qh", longopts, NULL)) != -1) {
         switch (c) {
         case 'o':
-            if (!*optarg) {
-                usage_error("%s", "--output needs a directory name");
-                return CS_EXIT_USAGE;
-            }
+            if (!*optarg)
+                return cs_cli_error(&CLI, "%s", "--output needs a directory name");
             o->out_dir = optarg;
             break;
         case OPT_SET:
-            if (!strchr(optarg, '=') || optarg[0] == '=') {
-                usage_error("--set needs KEY=VALUE, got '%s'", optarg);
-                return CS_EXIT_USAGE;
-            }
+            if (!strchr(optarg, '=') || optarg[0] == '=')
+                return cs_cli_error(&CLI, "--set needs KEY=VALUE, got '%s'", optarg);
             o->overrides[o->noverrides++] = optarg;
             break;
         case OPT_FORMAT:
-            if (!cs_mesh_format_from_name(optarg, NULL)) {
-                usage_error("--format: '%s' is not one of ply, obj, glb", optarg);
-                return CS_EXIT_USAGE;
-            }
+            if (!cs_mesh_format_from_name(optarg, NULL))
+                return cs_cli_error(&CLI, "--format: '%s' is not one of ply, obj, glb", optarg);
             o->format = optarg;
             break;
         case OPT_FRAMES:
-            if (!whole_number(optarg, 0, CS_MAX_FRAMES, NULL)) {
-                usage_error("--frames: '%s' is not a whole number from 0 to 100000000", optarg);
-                return CS_EXIT_USAGE;
-            }
+            if (!whole_number(optarg, 0, CS_MAX_FRAMES, NULL))
+                return cs_cli_error(&CLI,
+                                    "--frames: '%s' is not a whole number from 0 to 100000000",
+                                    optarg);
             frames = optarg;
             break;
         case OPT_THREADS:
-            if (!whole_number(optarg, 1, 4096, &o->threads)) {
-                usage_error("--threads: '%s' is not a whole number from 1 to 4096", optarg);
-                return CS_EXIT_USAGE;
-            }
+            if (!whole_number(optarg, 1, 4096, &o->threads))
+                return cs_cli_error(&CLI, "--threads: '%s' is not a whole number from 1 to 4096",
+                                    optarg);
             break;
         case OPT_PLAN:
             o->plan_only = true;
@@ -228,32 +220,17 @@ static int parse_options(int argc, char **argv, run_options *o)
         case 'h':
             cs_run_help(stdout);
             return CS_EXIT_OK;
-        case ':':
-            usage_error("option '%s' needs a value", argv[optind - 1]);
-            return CS_EXIT_USAGE;
-        default: {
-            const char *arg = argv[optind - 1];
-            char shortopt[3] = {'-', (char)optopt, '\0'};
-            if (strncmp(arg, "--", 2) != 0 && optopt > ' ' && optopt < 127)
-                arg = shortopt;   /* e.g. the x of -qx */
-            usage_error("unknown option '%s'", arg);
-            return CS_EXIT_USAGE;
-        }
+        default:
+            return cs_cli_option_error(&CLI, c, argv);
         }
     }
-    if (optind >= argc) {
-        usage_error("%s", "no scene file given");
-        return CS_EXIT_USAGE;
-    }
-    if (argc - optind > 1) {
-        usage_error("one scene file only; '%s' is one too many", argv[optind + 1]);
-        return CS_EXIT_USAGE;
-    }
+    if (optind >= argc)
+        return cs_cli_error(&CLI, "%s", "no scene file given");
+    if (argc - optind > 1)
+        return cs_cli_error(&CLI, "one scene file only; '%s' is one too many", argv[optind + 1]);
     o->scene_path = argv[optind];
-    if ((o->render_size || o->render_samples) && !o->render) {
-        usage_error("%s", "--size and --samples go with --render ENGINE");
-        return CS_EXIT_USAGE;
-    }
+    if ((o->render_size || o->render_samples) && !o->render)
+        return cs_cli_error(&CLI, "%s", "--size and --samples go with --render ENGINE");
     if (frames) {
         size_t len = strlen("time.frames=") + strlen(frames) + 1;
         o->frames_override = malloc(len);
@@ -274,13 +251,6 @@ static void free_options(run_options *o)
 }
 
 /* ------------------------------------------------------------------ utils */
-
-static double now_seconds(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
 
 static volatile sig_atomic_t interrupted = 0;
 
@@ -316,11 +286,11 @@ typedef struct run_state {
     const char *summary_path;
     cs_run_identity id;      /* what a resumed run must be made from */
     int first_frame;         /* frame 0, or the frame --resume continues after */
-    double summary_at;       /* now_seconds() of the last summary.json written */
+    double summary_at;       /* cs_now() of the last summary.json written */
     cs_mesh_view *views;     /* one per cloth */
     cs_run_render *render;   /* --render: an image per frame too */
     cs_summary summary;
-    double start;            /* now_seconds() when the command began */
+    double start;            /* cs_now() when the command began */
 } run_state;
 
 static int write_frame(run_state *r, int frame, char *err, size_t errlen)
@@ -334,15 +304,12 @@ static int write_frame(run_state *r, int frame, char *err, size_t errlen)
         r->views[c].nt = mesh->nt;
         r->views[c].tri = mesh->tri;
     }
-    char path[4096];
-    snprintf(path, sizeof path, "%s/frame_%04d.%s", r->frames_dir, frame,
-             cs_mesh_format_extension(r->format));
-    double t0 = now_seconds();
-    int rc = cs_mesh_write(path, r->format, ncloths, r->views, err, errlen);
+    double t0 = cs_now();
+    int rc = cs_frame_write(&r->out.layout, r->frames_dir, frame, r->views, err, errlen);
     if (rc == CS_IMPORT_OK && r->render && cs_run_render_frame(r->render, r->sim, frame, err,
                                                                errlen) != 0)
         rc = CS_IMPORT_BAD_INPUT;
-    r->summary.output_seconds += now_seconds() - t0;
+    r->summary.output_seconds += cs_now() - t0;
     if (rc == CS_IMPORT_OK)
         r->summary.frames_written = frame + 1;
     return rc;
@@ -352,10 +319,10 @@ static int write_frame(run_state *r, int frame, char *err, size_t errlen)
  * frames.jsonl (a constant cost per frame); once it is final, whole. */
 static int write_summary(run_state *r, char *err, size_t errlen)
 {
-    r->summary.total_seconds = r->summary.base_seconds + now_seconds() - r->start;
+    r->summary.total_seconds = r->summary.base_seconds + cs_now() - r->start;
     cs_summary_take_timing(&r->summary, r->sim);
     bool final = strcmp(r->summary.status, "running") != 0;
-    r->summary_at = now_seconds();
+    r->summary_at = cs_now();
     return cs_summary_write(&r->summary, r->summary_path, final, err, errlen);
 }
 
@@ -363,10 +330,10 @@ static int write_summary(run_state *r, char *err, size_t errlen)
  * from (cs_sim_state_gather came first, on every rank). */
 static int save_state(run_state *r, int frame, const char *hash, char *err, size_t errlen)
 {
-    double t0 = now_seconds();
+    double t0 = cs_now();
     int rc = cs_outdir_save_state(&r->out, &r->id, frame, hash, r->sim, &r->summary, err,
                                   errlen);
-    r->summary.output_seconds += now_seconds() - t0;
+    r->summary.output_seconds += cs_now() - t0;
     return rc;
 }
 
@@ -467,12 +434,12 @@ static int record_frame(run_state *r, int frame, const cs_frame_stats *stats, do
         return output_failed(r, progress, err, "the output could not be written to the disk",
                              frame);
     /* while running, at most once a second: frames.jsonl has every frame */
-    if (now_seconds() - r->summary_at >= 1.0 && write_summary(r, err, sizeof err) != 0) {
+    if (cs_now() - r->summary_at >= 1.0 && write_summary(r, err, sizeof err) != 0) {
         cs_progress_finish(progress);
         fprintf(stderr, "clothsim: %s\n", err);
         return -CS_EXIT_OUTPUT;
     }
-    cs_progress_frame(progress, frame, rec.time, now_seconds() - sim_start);
+    cs_progress_frame(progress, frame, rec.time, cs_now() - sim_start);
     if (!interrupted)
         return CS_EXIT_OK;
     s->status = "interrupted"; /* the frame is kept; nothing more is simulated */
@@ -509,7 +476,7 @@ static int simulate(run_state *r, const run_options *o)
     install_signal_handlers();
     if (root)
         status = cs_outdir_start(&r->out, o->resume, o->quiet, &r->id, r->sim, &r->summary,
-                                 r->format, r->scene->frames, &r->first_frame);
+                                 r->scene->frames, &r->first_frame);
     if ((status = cs_sim_agree(r->sim, status)) != CS_EXIT_OK)
         return status;
     r->first_frame = cs_sim_agree(r->sim, r->first_frame);
@@ -535,14 +502,14 @@ static int simulate(run_state *r, const run_options *o)
         return -status;
 
     cs_progress_frame(&progress, r->first_frame, cs_sim_time(r->sim), 0.0);
-    double sim_start = now_seconds();
+    double sim_start = cs_now();
     for (int frame = r->first_frame + 1; status == CS_EXIT_OK && frame <= r->scene->frames;
          frame++) {
         cs_frame_stats stats;
         memset(&stats, 0, sizeof stats);
-        double t0 = now_seconds();
+        double t0 = cs_now();
         int rc = cs_sim_advance_frame(r->sim, &stats);
-        double seconds = now_seconds() - t0;
+        double seconds = cs_now() - t0;
         s->simulation_seconds += seconds;
 
         if (rc == CS_ERR_UNSTABLE) { /* every rank sees the same rc */
@@ -625,7 +592,7 @@ int cs_run_main(int argc, char **argv)
     run_state r;
     memset(&r, 0, sizeof r);
     r.out.lock = CS_DIR_LOCK_NONE;
-    r.start = now_seconds();
+    r.start = cs_now();
     cs_summary_init(&r.summary);
     cs_scene *scene = NULL;
     char err[ERRLEN] = "";
@@ -701,21 +668,18 @@ int cs_run_main(int argc, char **argv)
 
     cs_summary *s = &r.summary;
     int triangles = 0;
-    char (*names)[32] = calloc(ncloths > 0 ? (size_t)ncloths : 1, sizeof *names);
-    if (!names) {
+    const char **names = calloc(ncloths > 0 ? (size_t)ncloths : 1, sizeof *names);
+    for (int c = 0; names && c < ncloths; c++) {
+        names[c] = cs_sim_cloth_name(r.sim, c);
+        triangles += cs_sim_cloth_mesh(r.sim, c)->nt;
+    }
+    if (!names || cs_frame_layout_init(&r.out.layout, r.format, ncloths, names) != 0) {
+        free(names);
         fprintf(stderr, "clothsim: out of memory\n");
         status = CS_EXIT_OUTPUT;
         goto done;
     }
-    for (int c = 0; c < ncloths; c++) {
-        const char *name = cs_sim_cloth_name(r.sim, c);
-        if (!name || !*name) {
-            snprintf(names[c], sizeof names[c], "cloth_%d", c);
-            name = names[c];
-        }
-        r.views[c].name = name;
-        triangles += cs_sim_cloth_mesh(r.sim, c)->nt;
-    }
+    free(names);
     s->scene = scene->name;
     s->self_collision = scene->def.self_collision;
     s->scene_file = scene->path;
@@ -736,13 +700,10 @@ int cs_run_main(int argc, char **argv)
     if (o.render && root) {
         r.render = cs_run_render_create(scene, r.sim, o.render, o.render_size, o.render_samples,
                                         r.out.dir, &status);
-        if (!r.render) {
-            free(names);
+        if (!r.render)
             goto done;
-        }
     }
     status = simulate(&r, &o);
-    free(names);
 
 done:
     cs_run_render_destroy(r.render);

@@ -1,8 +1,9 @@
 /* scene_render.c: a scene as render/ meshes; see scene_render.h. */
-#include "app/fsutil.h"
 #include "app/scene_render.h"
 
+#include "app/outdir.h"
 #include "app/run.h"
+#include "common/util.h"
 
 #include <dirent.h>
 #include <errno.h>
@@ -625,7 +626,7 @@ int cs_run_render_frame(cs_run_render *rr, const cs_sim *sim, int frame, char *e
         return -1;
     }
     char path[4096];
-    snprintf(path, sizeof path, "%s/frame_%04d.png", rr->images_dir, frame);
+    cs_frame_path(path, sizeof path, rr->images_dir, frame, NULL, "png");
     if (cs_image_write_png(rr->image, path, msg, sizeof msg) != CS_RENDER_OK) {
         snprintf(err, errlen, "%s", msg);
         return -1;

@@ -17,6 +17,7 @@
 #include <stddef.h>
 #include <stdio.h>
 
+#include "import/import.h"
 #include "sim/sim.h"
 
 /* Ranks listed one by one in summary.json (more are summed in "stages"). */
@@ -122,5 +123,20 @@ int cs_summary_write(const cs_summary *s, const char *path, bool final, char *er
 
 /* The stage table: per planned stage seconds, share %, calls; then totals. */
 void cs_summary_print_table(const cs_summary *s, FILE *out);
+
+/* What `clothsim render` reads back from a run's summary.json. */
+typedef struct cs_run_info {
+    char *scene_file;
+    int noverrides;
+    char **overrides;        /* the run's --set overrides, as given */
+    cs_mesh_format format;
+    int frames_written;
+    double fps;
+} cs_run_info;
+
+/* Reads DIR/summary.json. Returns 0, or an exit status (CS_EXIT_INPUT: no
+ * summary, or not one 'clothsim run' wrote) with err. */
+int cs_run_info_read(const char *dir, cs_run_info *info, char *err, size_t errlen);
+void cs_run_info_free(cs_run_info *info);
 
 #endif

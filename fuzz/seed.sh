@@ -125,10 +125,14 @@ bodies:
     interior: fill
 YAML
 
-# ---- scene dictionary: the schema's quoted words, as "word" and "word:"
-grep -o '"[a-z_][a-z0-9_]*"' "$root/import/scene_schema.c" | sort -u | while read -r w; do
-    printf '%s\n' "$w"
-    printf '"%s:"\n' "$(echo "$w" | tr -d '"')"
+# ---- scene dictionary: the key table's names and the schema's quoted
+# words (enum values), as "word" and "word:"
+{
+    grep -o '^CS_KEY([a-z_]*, [a-z_0-9]*' "$root/import/scene_keys.def" | sed 's/.*, //'
+    grep -o '"[a-z_][a-z0-9_]*"' "$root/import/scene_schema.c" | tr -d '"'
+} | sort -u | while read -r w; do
+    printf '"%s"\n' "$w"
+    printf '"%s:"\n' "$w"
 done > "$build/scene.dict"
 
 # ---- mesh seeds: one byte (extension index, reader 0 = cs_mesh_import),

@@ -8,6 +8,9 @@
 #ifndef CS_IMPORT_H
 #define CS_IMPORT_H
 
+#include <stdbool.h>
+#include <stdio.h>
+
 #include "import/levelset.h"
 #include "sim/sim.h"
 
@@ -59,6 +62,13 @@ int cs_mesh_write(const char *path, cs_mesh_format format, int nmeshes,
  * give their vertices: a frame of a cloth without triangles is a point
  * cloud (nt 0). NULL with err on failure. */
 cs_trimesh *cs_mesh_read(const char *path, char *err, size_t errlen);
+
+/* The same for the named meshes of a file (cs_mesh_write's views, one
+ * child process for all): out[i] gets the nodes and meshes named names[i],
+ * merged. Returns CS_IMPORT_OK, or a CS_IMPORT_* status with err (a name
+ * the file does not have is CS_IMPORT_BAD_INPUT) and every out[i] NULL. */
+int cs_mesh_read_named(const char *path, int n, const char *const *names, cs_trimesh **out,
+                       char *err, size_t errlen);
 
 /* --------------------------------------------------------- mesh import */
 
@@ -236,6 +246,21 @@ bool cs_levelset_auto_fill(const cs_mesh_report *mesh, double voxel);
 double cs_levelset_default_voxel(const cs_mesh_report *mesh, double cloth_edge, double band,
                                  bool fill_interior);
 
+/* The mesh a mesh body's grid is made of (shared by scenes and `clothsim
+ * levelset`): mesh itself when it is closed or close_holes is false, else a
+ * copy with each boundary loop closed by a fan (*holes_closed of them),
+ * which the caller destroys. *closed gets the report of what is returned.
+ * NULL when memory runs out. */
+cs_trimesh *cs_mesh_body_sign_mesh(cs_trimesh *mesh, const cs_mesh_report *rep, bool close_holes,
+                                   int *holes_closed, cs_mesh_report *closed);
+
+/* The grid of a mesh body: *voxel as given (> 0), else the default for
+ * cloth_edge (see cs_levelset_default_voxel); *fill as interior says (auto:
+ * cs_levelset_auto_fill). False, with a phrase in why, when the voxel size
+ * does not suit the mesh (cs_levelset_voxel_ok). */
+bool cs_mesh_body_grid(const cs_mesh_report *mesh, double *voxel, double cloth_edge, double band,
+                       cs_interior_mode interior, bool *fill, char *why, size_t len);
+
 /* ------------------------------------------------------------- scenes */
 
 typedef struct cs_camera_def {
@@ -298,6 +323,12 @@ int cs_scene_load_string(const char *text, const char *origin,
                          cs_scene **out, char *err, size_t errlen);
 
 void cs_scene_destroy(cs_scene *scene);
+
+/* The scene file reference, made from the table of keys (scene_keys.def):
+ * as text for `clothsim help scene`, or (markdown) as the tables README.md
+ * holds between <!-- scene-reference:begin SECTION --> and
+ * <!-- scene-reference:end SECTION --> lines. */
+void cs_scene_reference(FILE *out, bool markdown);
 
 #ifdef __cplusplus
 }

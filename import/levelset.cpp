@@ -3,6 +3,8 @@
 // a sentence for the C side; nothing C++ crosses the interface.
 #include "import/levelset.h"
 
+#include "common/util.h"
+
 #include <openvdb/openvdb.h>
 #include <openvdb/io/File.h>
 #include <openvdb/tools/MeshToVolume.h>
@@ -126,36 +128,47 @@ cs_levelset *cs_levelset_create(const cs_trimesh *mesh, double voxel_size, doubl
 
 void cs_levelset_destroy(cs_levelset *ls) { delete ls; }
 
-int cs_levelset_write(const cs_levelset *ls, const char *path, const char *grid_name, int nmeta,
-                      const char *const *keys, const char *const *values, char *err,
-                      size_t errlen)
+namespace {
+struct vdb_file {
+    const cs_levelset *ls;
+    const char *grid_name;
+    int nmeta;
+    const char *const *keys, *const *values;
+};
+} // namespace
+
+// The grid as the VDB file tmp; no exception leaves (cs_write_atomic is C).
+static int fill_vdb(const char *tmp, void *ctx, char *why, size_t whylen)
 {
-    // a name of this process's own: two runs may fill the same cache entry
-    std::string tmp = std::string(path) + ".tmp" + std::to_string((long)getpid());
+    const vdb_file *v = static_cast<const vdb_file *>(ctx);
     try {
         init_once();
         // The file gets a copy that shares the tree, so names and metadata
         // added here do not touch the grid in use.
-        openvdb::FloatGrid::Ptr copy = ls->grid->copy();
-        copy->setName(grid_name && *grid_name ? grid_name : "phi");
-        for (int i = 0; i < nmeta; i++)
-            copy->insertMeta(keys[i], openvdb::StringMetadata(values[i]));
+        openvdb::FloatGrid::Ptr copy = v->ls->grid->copy();
+        copy->setName(v->grid_name && *v->grid_name ? v->grid_name : "phi");
+        for (int i = 0; i < v->nmeta; i++)
+            copy->insertMeta(v->keys[i], openvdb::StringMetadata(v->values[i]));
         openvdb::GridPtrVec grids;
         grids.push_back(copy);
         openvdb::io::File file(tmp);
         file.write(grids);
         file.close();
     } catch (const std::exception &e) {
-        std::remove(tmp.c_str());
-        set_err(err, errlen, "cannot write %s: %s", path, e.what());
-        return -1;
-    }
-    if (std::rename(tmp.c_str(), path) != 0) {
-        set_err(err, errlen, "cannot write %s: %s", path, std::strerror(errno));
-        std::remove(tmp.c_str());
+        std::snprintf(why, whylen, "%s", e.what());
         return -1;
     }
     return 0;
+}
+
+int cs_levelset_write(const cs_levelset *ls, const char *path, const char *grid_name, int nmeta,
+                      const char *const *keys, const char *const *values, char *err,
+                      size_t errlen)
+{
+    vdb_file v = {ls, grid_name, nmeta, keys, values};
+    // a temporary name of this process's own: two runs may fill the same
+    // cache entry
+    return cs_write_atomic(path, true, fill_vdb, &v, err, errlen);
 }
 
 cs_levelset *cs_levelset_read(const char *path, const char *meta_key, const char *meta_value,

@@ -10,6 +10,8 @@
  * exactly when it would come out the same, whatever the files' times. */
 #include "import/import.h"
 
+#include "common/util.h"
+
 #include "import/sha256.h"
 
 #include <errno.h>
@@ -169,28 +171,6 @@ char *cs_levelset_cache_dir(const char *setting, const char *base_dir)
     return join(base, ".clothsim-cache");
 }
 
-/* mkdir -p */
-static int make_dirs(const char *path)
-{
-    char *p = dup_str(path);
-    if (!p)
-        return -1;
-    int rc = 0;
-    for (char *s = p + 1;; s++) {
-        if (*s == '/' || *s == '\0') {
-            char keep = *s;
-            *s = '\0';
-            if (mkdir(p, 0777) != 0 && errno != EEXIST)
-                rc = -1;
-            *s = keep;
-            if (rc != 0 || keep == '\0')
-                break;
-        }
-    }
-    free(p);
-    return rc;
-}
-
 static void compute_key(const cs_trimesh *mesh, const cs_levelset_request *req, char key[65])
 {
     cs_sha256 h;
@@ -263,7 +243,7 @@ int cs_levelset_build(const cs_trimesh *mesh, const cs_levelset_request *req,
         snprintf(voxel, sizeof voxel, "%.17g", req->voxel_size);
         const char *keys[] = {"clothsim_key", "clothsim_source", "clothsim_voxel_size"};
         const char *values[] = {res->key, req->label ? req->label : "", voxel};
-        if (make_dirs(req->cache_dir) != 0) {
+        if (cs_make_dirs(req->cache_dir) != 0) {
             snprintf(res->cache_note, sizeof res->cache_note,
                      "cannot create the cache directory %s: %s; the grid is not kept",
                      req->cache_dir, strerror(errno));

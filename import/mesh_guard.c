@@ -13,6 +13,7 @@
  * What it costs is measured at the top of mesh_import.c.
  */
 #include "import/mesh_internal.h"
+#include "common/util.h"
 
 #include <errno.h>
 #include <poll.h>
@@ -239,19 +240,12 @@ static _Noreturn void child_main(int fd, const limits *l, cs_guarded_fn fn, void
 
 /* ----------------------------------------------------------- parent */
 
-static double now(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
-
 /* Reads the child's answer until it closes the pipe or the deadline. */
 static bool read_answer(int fd, double deadline, cs_bytes *buf)
 {
     unsigned char chunk[65536];
     for (;;) {
-        double left = deadline - now();
+        double left = deadline - cs_now();
         if (left <= 0)
             return false;
         struct pollfd p = {.fd = fd, .events = POLLIN};
@@ -342,7 +336,7 @@ int cs_guard_run(const char *path, cs_guarded_fn fn, void *ctx, cs_bytes *result
     }
     close(fds[1]);
     cs_bytes buf = {0};
-    bool answered = read_answer(fds[0], now() + l.wall_seconds, &buf);
+    bool answered = read_answer(fds[0], cs_now() + l.wall_seconds, &buf);
     close(fds[0]);
     if (!answered)
         kill(pid, SIGKILL);

@@ -420,48 +420,80 @@ static cs_trimesh *get_mesh(cs_bytes_reader *r)
     return m;
 }
 
-/* In the child: a file as written, every mesh merged. */
+/* What cs_mesh_read and cs_mesh_read_named read: every mesh merged
+ * (names NULL, n 1), or per name its nodes and meshes. */
+typedef struct read_request {
+    const char *path;
+    int n;
+    const char *const *names;
+} read_request;
+
+/* In the child: a file as written, a mesh per request. */
 static int read_in_child(void *ctx, cs_bytes *out, char *err, size_t errlen)
 {
-    const char *path = ctx;
+    const read_request *q = ctx;
+    const char *path = q->path;
     const struct aiScene *scene;
     int rc = open_scene(path, aiProcess_Triangulate, true, &scene, err, errlen);
-    if (rc != CS_IMPORT_OK)
-        return rc;
-    double *x = NULL;
-    int *tri = NULL;
-    long nv = 0, nt = 0;
-    int nodes;
-    walk_state st;
-    rc = read_merged(scene, path, NULL, true, &x, &nv, &tri, &nt, &nodes, &st, err, errlen);
-    if (rc == CS_IMPORT_OK && st.bad_vertex >= 0) {
-        set_err(err, errlen, "%s: vertex %d has a non-finite coordinate", path, st.bad_vertex);
-        rc = CS_IMPORT_BAD_INPUT;
+    for (int i = 0; i < q->n && rc == CS_IMPORT_OK; i++) {
+        double *x = NULL;
+        int *tri = NULL;
+        long nv = 0, nt = 0;
+        int nodes;
+        walk_state st;
+        rc = read_merged(scene, path, q->names ? q->names[i] : NULL, true, &x, &nv, &tri, &nt,
+                         &nodes, &st, err, errlen);
+        if (rc == CS_IMPORT_OK && st.bad_vertex >= 0) {
+            set_err(err, errlen, "%s: vertex %d has a non-finite coordinate", path,
+                    st.bad_vertex);
+            rc = CS_IMPORT_BAD_INPUT;
+        }
+        if (rc == CS_IMPORT_OK)
+            put_mesh(out, &(cs_trimesh){(int)nv, (int)nt, x, tri});
+        free(x);
+        free(tri);
     }
-    if (rc == CS_IMPORT_OK)
-        put_mesh(out, &(cs_trimesh){(int)nv, (int)nt, x, tri});
-    free(x);
-    free(tri);
-    aiReleaseImport(scene);
+    if (scene)
+        aiReleaseImport(scene);
     return rc;
 }
 
-cs_trimesh *cs_mesh_read(const char *path, char *err, size_t errlen)
+static int read_meshes(const read_request *q, cs_trimesh **out, char *err, size_t errlen)
 {
     /* Nothing is repaired or reordered: frames read back as written. PLY
      * and glTF keep the writer's vertex numbering; formats that list
      * vertices per corner (OBJ, STL) have identical ones joined by assimp. */
     cs_bytes res;
-    if (cs_guard_run(path, read_in_child, (void *)path, &res, err, errlen) != CS_IMPORT_OK) {
-        cs_bytes_free(&res);
-        return NULL;
-    }
+    int rc = cs_guard_run(q->path, read_in_child, (void *)q, &res, err, errlen);
     cs_bytes_reader r = {res.data, res.len, false};
-    cs_trimesh *m = get_mesh(&r);
+    for (int i = 0; i < q->n; i++) {
+        out[i] = rc == CS_IMPORT_OK ? get_mesh(&r) : NULL;
+        if (rc == CS_IMPORT_OK && !out[i]) {
+            set_err(err, errlen, "%s: out of memory", q->path);
+            rc = CS_IMPORT_NOMEM;
+        }
+    }
     cs_bytes_free(&res);
-    if (!m)
-        set_err(err, errlen, "%s: out of memory", path);
+    for (int i = 0; rc != CS_IMPORT_OK && i < q->n; i++) {
+        cs_trimesh_destroy(out[i]);
+        out[i] = NULL;
+    }
+    return rc;
+}
+
+cs_trimesh *cs_mesh_read(const char *path, char *err, size_t errlen)
+{
+    read_request q = {path, 1, NULL};
+    cs_trimesh *m = NULL;
+    read_meshes(&q, &m, err, errlen);
     return m;
+}
+
+int cs_mesh_read_named(const char *path, int n, const char *const *names, cs_trimesh **out,
+                       char *err, size_t errlen)
+{
+    read_request q = {path, n, names};
+    return read_meshes(&q, out, err, errlen);
 }
 
 /* A warning when a mesh read in a format without units is an implausible

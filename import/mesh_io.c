@@ -11,6 +11,8 @@
  */
 #include "import/mesh_internal.h"
 
+#include "common/util.h"
+
 #include <assimp/cexport.h>
 #include <assimp/cimport.h>
 #include <assimp/postprocess.h>
@@ -332,24 +334,6 @@ static bool check_views(const char *path, int nmeshes, const cs_mesh_view *meshe
     return true;
 }
 
-/* data as the file path, every write checked (fwrite, fflush, fclose).
- * Returns 0, or -1 with errno. */
-static int write_checked(const char *path, const void *data, size_t size)
-{
-    errno = 0;
-    FILE *fp = fopen(path, "wb");
-    if (!fp)
-        return -1;
-    int failed = fwrite(data, 1, size, fp) != size || fflush(fp) != 0;
-    int saved = errno;
-    if (fclose(fp) != 0 && !failed) {
-        failed = 1;
-        saved = errno;
-    }
-    errno = saved ? saved : EIO;
-    return failed ? -1 : 0;
-}
-
 int cs_mesh_write(const char *path, cs_mesh_format format, int nmeshes,
                   const cs_mesh_view *meshes, char *err, size_t errlen)
 {
@@ -364,33 +348,13 @@ int cs_mesh_write(const char *path, cs_mesh_format format, int nmeshes,
     if (!check_views(path, nmeshes, meshes, err, errlen))
         return CS_IMPORT_BAD_INPUT;
 
-    size_t len = strlen(path);
-    char *tmp = malloc(len + 5);
-    if (!tmp) {
-        set_err(err, errlen, "%s: out of memory", path);
-        return CS_IMPORT_NOMEM;
-    }
-    memcpy(tmp, path, len);
-    memcpy(tmp + len, ".tmp", 5);
-
-    /* Open the file ourselves first: assimp's C API loses the exporter's
-     * message, while errno says exactly why a path cannot be written. */
-    FILE *probe = fopen(tmp, "wb");
-    if (!probe) {
-        set_err(err, errlen, "cannot write %s: %s", path, strerror(errno));
-        free(tmp);
-        return CS_IMPORT_BAD_INPUT;
-    }
-    fclose(probe);
-
     bool points_only = format == CS_MESH_PLY;
     for (int m = 0; m < nmeshes; m++)
         points_only = points_only && meshes[m].nt == 0;
     cs_bytes points = {0};
     struct aiScene *scene = points_only ? NULL : build_scene(nmeshes, meshes);
     if (points_only ? !ply_points(nmeshes, meshes, &points) : !scene) {
-        remove(tmp);
-        free(tmp);
+        cs_bytes_free(&points);
         set_err(err, errlen, "%s: out of memory", path);
         return CS_IMPORT_NOMEM;
     }
@@ -408,20 +372,12 @@ int cs_mesh_write(const char *path, cs_mesh_format format, int nmeshes,
         set_err(err, errlen, "cannot write %s: assimp's '%s' exporter failed",
                 path, FORMATS[format].assimp_id);
         status = CS_IMPORT_BAD_INPUT;
-    } else if (write_checked(tmp, data, size) != 0) {
-        set_err(err, errlen, "cannot write %s: %s", path, strerror(errno));
-        status = CS_IMPORT_BAD_INPUT;
-    } else if (rename(tmp, path) != 0) {
-        set_err(err, errlen, "cannot write %s: rename from %s failed: %s",
-                path, tmp, strerror(errno));
+    } else if (cs_file_write_atomic(path, data, size, err, errlen) != 0) {
         status = CS_IMPORT_BAD_INPUT;
     }
     if (blob)
         aiReleaseExportBlob(blob);
     cs_bytes_free(&points);
-    if (status != CS_IMPORT_OK)
-        remove(tmp);
-    free(tmp);
     return status;
 }
 

@@ -1,8 +1,9 @@
-/* scene_schema.c: the libcyaml schema of a scene file and queries on it.
- * README.md (Scene file reference) describes the same keys for users; keep the two
- * in step. */
+/* scene_schema.c: the libcyaml schema of a scene file, the key descriptors,
+ * and queries on them; all made from scene_keys.def, which README.md's scene
+ * reference is printed from too (tests/cli_scene_reference.sh). */
 #include "import/scene_schema.h"
 
+#include <stddef.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -30,240 +31,278 @@ static const cyaml_schema_value_t int2_value = {
     CYAML_VALUE_SEQUENCE_FIXED(CYAML_FLAG_DEFAULT, int, &int_value, 2),
 };
 
-#define VEC(key, flags, type, member, n) \
-    CYAML_FIELD_SEQUENCE_FIXED(key, flags, type, member, &float_value, n)
-#define NUM(key, type, member) CYAML_FIELD_FLOAT_PTR(key, OPT, type, member)
-#define INT(key, type, member) CYAML_FIELD_INT_PTR(key, OPT, type, member)
-#define BOOL(key, type, member) CYAML_FIELD_BOOL_PTR(key, OPT, type, member)
-#define STR(key, type, member) \
-    CYAML_FIELD_STRING_PTR(key, OPT, type, member, 0, CYAML_UNLIMITED)
-
+/* The names of the ENUM keys' values (ARG in scene_keys.def). */
 static const cyaml_strval_t friction_names[] = {
     {"improved", CS_FRICTION_IMPROVED},
     {"projection", CS_FRICTION_PROJECTION},
 };
-
-const char *const cs_scene_format_names[] = {"ply", "obj", "glb"};
-static const cyaml_strval_t format_names[] = {{"ply", 0}, {"obj", 1}, {"glb", 2}};
-
-static const cyaml_strval_t shape_names[] = {
-    {"plane", CS_BODY_PLANE},
-    {"sphere", CS_BODY_SPHERE},
-    {"box", CS_BODY_BOX},
-    {"cylinder", CS_BODY_CYLINDER},
-    {"mesh", CS_BODY_MESH},
+static const cyaml_strval_t scheme_names[] = {
+    {"fixed", CS_COLLISION_FIXED},
+    {"rewind", CS_COLLISION_REWIND},
 };
-
-const char *const cs_scene_unit_names[CS_SCENE_UNIT_COUNT] = {"auto", "m",  "cm", "mm",
-                                                              "km",   "in", "ft"};
+static const cyaml_strval_t format_names[] = {{"ply", 0}, {"obj", 1}, {"glb", 2}};
+static const cyaml_strval_t shape_names[] = {
+    {"plane", CS_BODY_PLANE},       {"sphere", CS_BODY_SPHERE}, {"box", CS_BODY_BOX},
+    {"cylinder", CS_BODY_CYLINDER}, {"mesh", CS_BODY_MESH},
+};
 static const cyaml_strval_t interior_names[] = {
     {"auto", CS_INTERIOR_AUTO}, {"fill", CS_INTERIOR_FILL}, {"band", CS_INTERIOR_BAND}};
 static const cyaml_strval_t unit_names[] = {{"auto", 0}, {"m", 1},  {"cm", 2}, {"mm", 3},
                                             {"km", 4},   {"in", 5}, {"ft", 6}};
 
-static const cyaml_schema_field_t time_fields[] = {
-    NUM("fps", cs_raw_time, fps),
-    INT("frames", cs_raw_time, frames),
-    STR("dt", cs_raw_time, dt),
-    NUM("dt_safety", cs_raw_time, dt_safety),
-    INT("collision_steps", cs_raw_time, collision_steps),
-    NUM("cg_tolerance", cs_raw_time, cg_tolerance),
-    INT("cg_max_iterations", cs_raw_time, cg_max_iterations),
-    CYAML_FIELD_END,
-};
-/* dt is a string in the schema only so that "auto" passes; say so. */
-#define DT_VALUE (&time_fields[2].value)
+/* The lower bound of a range: the least entries of a list. */
+#define CS_LO_ANY 0
+#define CS_LO_POS 0
+#define CS_LO_NONNEG 0
+#define CS_LO_UNIT 0
+#define CS_LO_R(lk, lo, hk, hi) lo
+#define CS_MIN(RANGE) CS_LO_##RANGE
 
-static const cyaml_schema_field_t effects_fields[] = {
-    BOOL("bodies", cs_raw_effects, bodies),
-    BOOL("wind", cs_raw_effects, wind),
-    BOOL("self_collision", cs_raw_effects, self_collision),
-    CYAML_FIELD_ENUM_PTR("friction", OPT | CYAML_FLAG_STRICT, cs_raw_effects, friction,
-                         friction_names, CYAML_ARRAY_LEN(friction_names)),
-    CYAML_FIELD_END,
-};
+/* One cyaml field per key. */
+#define F_NUM_OPT(t, k, a, r) CYAML_FIELD_FLOAT_PTR(#k, OPT, t, k)
+#define F_NUM_REQ(t, k, a, r) CYAML_FIELD_FLOAT(#k, CYAML_FLAG_DEFAULT, t, k)
+#define F_INT_OPT(t, k, a, r) CYAML_FIELD_INT_PTR(#k, OPT, t, k)
+#define F_BOOL_OPT(t, k, a, r) CYAML_FIELD_BOOL_PTR(#k, OPT, t, k)
+#define F_STR_OPT(t, k, a, r) CYAML_FIELD_STRING_PTR(#k, OPT, t, k, 0, CYAML_UNLIMITED)
+#define F_DT_OPT(t, k, a, r) F_STR_OPT(t, k, a, r)
+#define F_ENUM_OPT(t, k, a, r)                                                          \
+    CYAML_FIELD_ENUM_PTR(#k, OPT | CYAML_FLAG_STRICT, t, k, a##_names,                  \
+                         CYAML_ARRAY_LEN(a##_names))
+#define F_ENUM_REQ(t, k, a, r)                                                          \
+    CYAML_FIELD_ENUM(#k, CYAML_FLAG_STRICT, t, k, a##_names, CYAML_ARRAY_LEN(a##_names))
+#define F_VEC_OPT(t, k, a, r) CYAML_FIELD_SEQUENCE_FIXED(#k, OPT, t, k, &float_value, a)
+#define F_VEC_REQ(t, k, a, r) CYAML_FIELD_SEQUENCE_FIXED(#k, REQ, t, k, &float_value, a)
+#define F_IVEC_OPT(t, k, a, r) CYAML_FIELD_SEQUENCE_FIXED(#k, OPT, t, k, &int_value, a)
+#define F_SCALE_OPT(t, k, a, r) CYAML_FIELD_IGNORE(#k, CYAML_FLAG_OPTIONAL)
+#define F_MAP_OPT(t, k, a, r) CYAML_FIELD_MAPPING_PTR(#k, OPT, t, k, a##_fields)
+#define F_MAP_REQ(t, k, a, r) CYAML_FIELD_MAPPING_PTR(#k, REQ, t, k, a##_fields)
+#define F_LIST_OPT(t, k, a, r)                                                          \
+    CYAML_FIELD_SEQUENCE(#k, OPT, t, k, &a##_value, CS_MIN(r), CYAML_UNLIMITED)
+#define F_LIST_REQ(t, k, a, r)                                                          \
+    CYAML_FIELD_SEQUENCE(#k, REQ, t, k, &a##_value, CS_MIN(r), CYAML_UNLIMITED)
+#define F_VLIST_OPT(t, k, a, r)                                                         \
+    CYAML_FIELD_SEQUENCE(#k, OPT, t, k, &vec##a##_value, CS_MIN(r), CYAML_UNLIMITED)
+#define F_ILIST_OPT(t, k, a, r)                                                         \
+    CYAML_FIELD_SEQUENCE(#k, OPT, t, k, &int##a##_value, CS_MIN(r), CYAML_UNLIMITED)
+#define F_IDXLIST_OPT(t, k, a, r)                                                       \
+    CYAML_FIELD_SEQUENCE(#k, OPT, t, k, &int_value, CS_MIN(r), CYAML_UNLIMITED)
 
-static const cyaml_strval_t scheme_names[] = {
-    {"fixed", CS_COLLISION_FIXED},
-    {"rewind", CS_COLLISION_REWIND},
-};
-
-static const cyaml_schema_field_t self_fields[] = {
-    NUM("thickness", cs_raw_self, thickness),
-    NUM("stiffness", cs_raw_self, stiffness),
-    NUM("friction", cs_raw_self, friction),
-    NUM("edge_flip_epsilon", cs_raw_self, edge_flip_epsilon),
-    INT("zone_iterations", cs_raw_self, zone_iterations),
-    CYAML_FIELD_ENUM_PTR("scheme", OPT | CYAML_FLAG_STRICT, cs_raw_self, scheme, scheme_names,
-                         CYAML_ARRAY_LEN(scheme_names)),
-    BOOL("verify", cs_raw_self, verify),
-    CYAML_FIELD_END,
-};
-
-static const cyaml_schema_field_t wind_fields[] = {
-    VEC("velocity", OPT, cs_raw_wind, velocity, 3),
-    NUM("drag", cs_raw_wind, drag),
-    CYAML_FIELD_END,
-};
-
-static const cyaml_schema_field_t output_fields[] = {
-    CYAML_FIELD_ENUM_PTR("format", OPT | CYAML_FLAG_STRICT, cs_raw_output, format,
-                         format_names, CYAML_ARRAY_LEN(format_names)),
-    CYAML_FIELD_END,
-};
-
-static const cyaml_schema_field_t camera_fields[] = {
-    VEC("position", REQ, cs_raw_camera, position, 3),
-    VEC("target", REQ, cs_raw_camera, target, 3),
-    VEC("up", OPT, cs_raw_camera, up, 3),
-    NUM("fov", cs_raw_camera, fov),
-    CYAML_FIELD_END,
-};
-
-static const cyaml_schema_field_t grid_fields[] = {
-    VEC("size", OPT, cs_raw_grid, size, 2),
-    CYAML_FIELD_SEQUENCE_FIXED("resolution", OPT, cs_raw_grid, resolution, &int_value, 2),
-    VEC("center", OPT, cs_raw_grid, center, 3),
-    VEC("rotation", OPT, cs_raw_grid, rotation, 3),
-    CYAML_FIELD_END,
-};
-
-static const cyaml_schema_field_t mesh_fields[] = {
-    STR("file", cs_raw_mesh, file),
-    STR("node", cs_raw_mesh, node),
-    CYAML_FIELD_ENUM_PTR("units", OPT | CYAML_FLAG_STRICT, cs_raw_mesh, units, unit_names,
-                         CYAML_ARRAY_LEN(unit_names)),
-    CYAML_FIELD_IGNORE("scale", CYAML_FLAG_OPTIONAL),
-    CYAML_FIELD_SEQUENCE("vertices", OPT, cs_raw_mesh, vertices, &vec3_value, 1,
-                         CYAML_UNLIMITED),
-    CYAML_FIELD_SEQUENCE("triangles", OPT, cs_raw_mesh, triangles, &int3_value, 0,
-                         CYAML_UNLIMITED),
-    VEC("rotation", OPT, cs_raw_mesh, rotation, 3),
-    VEC("translate", OPT, cs_raw_mesh, translate, 3),
-    CYAML_FIELD_END,
-};
-
-static const cyaml_schema_field_t material_fields[] = {
-    NUM("edge_stiffness", cs_raw_material, edge_stiffness),
-    NUM("edge_overdamping", cs_raw_material, edge_overdamping),
-    NUM("bend_stiffness", cs_raw_material, bend_stiffness),
-    NUM("bend_overdamping", cs_raw_material, bend_overdamping),
-    NUM("node_mass", cs_raw_material, node_mass),
-    NUM("density", cs_raw_material, density),
-    CYAML_FIELD_END,
-};
-
-static const cyaml_schema_field_t box_fields[] = {
-    VEC("min", REQ, cs_raw_box, min, 3),
-    VEC("max", REQ, cs_raw_box, max, 3),
-    CYAML_FIELD_END,
-};
-
-static const cyaml_schema_field_t selection_fields[] = {
-    CYAML_FIELD_SEQUENCE("vertices", OPT, cs_raw_selection, vertices, &int_value, 1,
-                         CYAML_UNLIMITED),
-    CYAML_FIELD_MAPPING_PTR("box", OPT, cs_raw_selection, box, box_fields),
-    CYAML_FIELD_SEQUENCE("grid_points", OPT, cs_raw_selection, grid_points, &int2_value, 1,
-                         CYAML_UNLIMITED),
-    CYAML_FIELD_END,
-};
-static const cyaml_schema_value_t selection_value = {
-    CYAML_VALUE_MAPPING(CYAML_FLAG_DEFAULT, cs_raw_selection, selection_fields),
-};
-
-static const cyaml_schema_field_t key_fields[] = {
-    CYAML_FIELD_FLOAT("time", CYAML_FLAG_DEFAULT, cs_raw_key, time),
-    VEC("translate", OPT, cs_raw_key, translate, 3),
-    VEC("rotate", OPT, cs_raw_key, rotate, 3),
-    CYAML_FIELD_END,
-};
-static const cyaml_schema_value_t key_value = {
-    CYAML_VALUE_MAPPING(CYAML_FLAG_DEFAULT, cs_raw_key, key_fields),
-};
-
-static const cyaml_schema_field_t motion_fields[] = {
-    VEC("velocity", OPT, cs_raw_motion, velocity, 3),
-    VEC("angular_velocity", OPT, cs_raw_motion, angular_velocity, 3),
-    CYAML_FIELD_SEQUENCE("keys", OPT, cs_raw_motion, keys, &key_value, 1, CYAML_UNLIMITED),
-    CYAML_FIELD_END,
-};
-
-static const cyaml_schema_field_t script_fields[] = {
-    CYAML_FIELD_MAPPING_PTR("select", REQ, cs_raw_script, select, selection_fields),
-    VEC("pivot", OPT, cs_raw_script, pivot, 3),
-    CYAML_FIELD_MAPPING_PTR("motion", OPT, cs_raw_script, motion, motion_fields),
-    CYAML_FIELD_END,
-};
-static const cyaml_schema_value_t script_value = {
-    CYAML_VALUE_MAPPING(CYAML_FLAG_DEFAULT, cs_raw_script, script_fields),
-};
-
-static const cyaml_schema_field_t cloth_fields[] = {
-    STR("name", cs_raw_cloth, name),
-    VEC("color", OPT, cs_raw_cloth, color, 3),
-    CYAML_FIELD_MAPPING_PTR("grid", OPT, cs_raw_cloth, grid, grid_fields),
-    CYAML_FIELD_MAPPING_PTR("mesh", OPT, cs_raw_cloth, mesh, mesh_fields),
-    CYAML_FIELD_MAPPING_PTR("material", OPT, cs_raw_cloth, material, material_fields),
-    VEC("velocity", OPT, cs_raw_cloth, velocity, 3),
-    CYAML_FIELD_SEQUENCE("pins", OPT, cs_raw_cloth, pins, &selection_value, 0, CYAML_UNLIMITED),
-    CYAML_FIELD_SEQUENCE("scripts", OPT, cs_raw_cloth, scripts, &script_value, 0,
-                         CYAML_UNLIMITED),
-    CYAML_FIELD_END,
-};
-static const cyaml_schema_value_t cloth_value = {
-    CYAML_VALUE_MAPPING(CYAML_FLAG_DEFAULT, cs_raw_cloth, cloth_fields),
-};
-
-static const cyaml_schema_field_t body_fields[] = {
-    STR("name", cs_raw_body, name),
-    CYAML_FIELD_ENUM("shape", CYAML_FLAG_STRICT, cs_raw_body, shape, shape_names,
-                     CYAML_ARRAY_LEN(shape_names)),
-    VEC("position", OPT, cs_raw_body, position, 3),
-    VEC("rotation", OPT, cs_raw_body, rotation, 3),
-    VEC("normal", OPT, cs_raw_body, normal, 3),
-    NUM("radius", cs_raw_body, radius),
-    VEC("size", OPT, cs_raw_body, size, 3),
-    NUM("height", cs_raw_body, height),
-    NUM("friction", cs_raw_body, friction),
-    NUM("collision_offset", cs_raw_body, collision_offset),
-    VEC("color", OPT, cs_raw_body, color, 3),
-    CYAML_FIELD_MAPPING_PTR("motion", OPT, cs_raw_body, motion, motion_fields),
-    CYAML_FIELD_MAPPING_PTR("mesh", OPT, cs_raw_body, mesh, mesh_fields),
-    NUM("voxel_size", cs_raw_body, voxel_size),
-    NUM("band", cs_raw_body, band),
-    BOOL("close_holes", cs_raw_body, close_holes),
-    CYAML_FIELD_ENUM_PTR("interior", OPT | CYAML_FLAG_STRICT, cs_raw_body, interior,
-                         interior_names, CYAML_ARRAY_LEN(interior_names)),
-    CYAML_FIELD_END,
-};
-static const cyaml_schema_value_t body_value = {
-    CYAML_VALUE_MAPPING(CYAML_FLAG_DEFAULT, cs_raw_body, body_fields),
-};
-
-static const cyaml_schema_field_t levelset_fields[] = {
-    STR("cache", cs_raw_levelset, cache),
-    CYAML_FIELD_END,
-};
-
-static const cyaml_schema_field_t scene_fields[] = {
-    STR("name", cs_raw_scene, name),
-    STR("description", cs_raw_scene, description),
-    CYAML_FIELD_MAPPING_PTR("time", OPT, cs_raw_scene, time, time_fields),
-    VEC("gravity", OPT, cs_raw_scene, gravity, 3),
-    CYAML_FIELD_MAPPING_PTR("effects", OPT, cs_raw_scene, effects, effects_fields),
-    CYAML_FIELD_MAPPING_PTR("self_collision", OPT, cs_raw_scene, self_collision, self_fields),
-    CYAML_FIELD_MAPPING_PTR("wind", OPT, cs_raw_scene, wind, wind_fields),
-    CYAML_FIELD_MAPPING_PTR("output", OPT, cs_raw_scene, output, output_fields),
-    CYAML_FIELD_MAPPING_PTR("camera", OPT, cs_raw_scene, camera, camera_fields),
-    CYAML_FIELD_SEQUENCE("cloths", REQ, cs_raw_scene, cloths, &cloth_value, 1, CYAML_UNLIMITED),
-    CYAML_FIELD_SEQUENCE("bodies", OPT, cs_raw_scene, bodies, &body_value, 0, CYAML_UNLIMITED),
-    CYAML_FIELD_MAPPING_PTR("levelset", OPT, cs_raw_scene, levelset, levelset_fields),
-    CYAML_FIELD_END,
-};
+#define CS_SECTION(sec, ttype, tname, heading) static const cyaml_schema_field_t sec##_fields[] = {
+#define CS_KEY(sec, key, TYPE, ARG, REQ, DEF, DEFTEXT, RANGE, UNIT, HOW, FIELD, DOC) \
+    F_##TYPE##_##REQ(cs_raw_##sec, key, ARG, RANGE),
+#define CS_END(sec)                                                                     \
+    CYAML_FIELD_END                                                                     \
+    }                                                                                   \
+    ;                                                                                   \
+    static const cyaml_schema_value_t sec##_value = {                                   \
+        CYAML_VALUE_MAPPING(CYAML_FLAG_DEFAULT, cs_raw_##sec, sec##_fields),            \
+    };
+#include "import/scene_keys.def"
+#undef CS_SECTION
+#undef CS_KEY
+#undef CS_END
 
 const cyaml_schema_value_t cs_scene_schema = {
     CYAML_VALUE_MAPPING(CYAML_FLAG_POINTER, cs_raw_scene, scene_fields),
 };
+
+/* ------------------------------------------------------ key descriptors */
+
+/* Defaults: a function per key with one (i: the entry of a vector). */
+#define DEFVAL_D(x) (x)
+#define DEFVAL_NODEF 0
+#define HASDEF_D(x) 1
+#define HASDEF_NODEF 0
+#define CS_SECTION(sec, ttype, tname, heading)
+#define CS_KEY(sec, key, TYPE, ARG, REQ, DEF, DEFTEXT, RANGE, UNIT, HOW, FIELD, DOC) \
+    static double def_##sec##_##key(int i)                                          \
+    {                                                                               \
+        (void)i;                                                                    \
+        return (double)(DEFVAL_##DEF);                                              \
+    }
+#define CS_END(sec)
+#include "import/scene_keys.def"
+#undef CS_SECTION
+#undef CS_KEY
+#undef CS_END
+
+/* What the TO keys of a section are converted into. */
+#define CS_SECTION(sec, ttype, tname, heading) typedef ttype cs_target_##sec;
+#define CS_KEY(sec, key, TYPE, ARG, REQ, DEF, DEFTEXT, RANGE, UNIT, HOW, FIELD, DOC)
+#define CS_END(sec)
+#include "import/scene_keys.def"
+#undef CS_SECTION
+#undef CS_KEY
+#undef CS_END
+
+#define TARGET_TO(sec, f) (long)offsetof(cs_target_##sec, f)
+#define TARGET_HAND(sec, f) -1L
+#define RANGE_ANY {CS_BOUND_NONE, 0, CS_BOUND_NONE, 0}
+#define RANGE_POS {CS_BOUND_GT, 0, CS_BOUND_NONE, 0}
+#define RANGE_NONNEG {CS_BOUND_GE, 0, CS_BOUND_NONE, 0}
+#define RANGE_UNIT {CS_BOUND_GE, 0, CS_BOUND_GE, 1}
+#define RANGE_R(lk, lo, hk, hi) {CS_BOUND_##lk, lo, CS_BOUND_##hk, hi}
+#define RAW_SCALE(sec, key) 0
+#define RAW_NUM(sec, key) offsetof(cs_raw_##sec, key)
+#define RAW_INT RAW_NUM
+#define RAW_BOOL RAW_NUM
+#define RAW_STR RAW_NUM
+#define RAW_DT RAW_NUM
+#define RAW_ENUM RAW_NUM
+#define RAW_VEC RAW_NUM
+#define RAW_IVEC RAW_NUM
+#define RAW_MAP RAW_NUM
+#define RAW_LIST RAW_NUM
+#define RAW_VLIST RAW_NUM
+#define RAW_ILIST RAW_NUM
+#define RAW_IDXLIST RAW_NUM
+#define N_VEC(a) a
+#define N_IVEC(a) a
+#define N_VLIST(a) a
+#define N_ILIST(a) a
+#define CHILD_MAP(a) CS_SEC_##a
+#define CHILD_LIST(a) CS_SEC_##a
+#define NAMES_ENUM(a) a##_names, CYAML_ARRAY_LEN(a##_names)
+/* the ARG of other types means nothing */
+#define N_NUM(a) 0
+#define N_INT(a) 0
+#define N_BOOL(a) 0
+#define N_STR(a) 0
+#define N_DT(a) 0
+#define N_ENUM(a) 0
+#define N_SCALE(a) 3
+#define N_MAP(a) 0
+#define N_LIST(a) 0
+#define N_IDXLIST(a) 1
+#define CHILD_NUM(a) -1
+#define CHILD_INT(a) -1
+#define CHILD_BOOL(a) -1
+#define CHILD_STR(a) -1
+#define CHILD_DT(a) -1
+#define CHILD_ENUM(a) -1
+#define CHILD_VEC(a) -1
+#define CHILD_IVEC(a) -1
+#define CHILD_SCALE(a) -1
+#define CHILD_VLIST(a) -1
+#define CHILD_ILIST(a) -1
+#define CHILD_IDXLIST(a) -1
+#define NAMES_NUM(a) NULL, 0
+#define NAMES_INT(a) NULL, 0
+#define NAMES_BOOL(a) NULL, 0
+#define NAMES_STR(a) NULL, 0
+#define NAMES_DT(a) NULL, 0
+#define NAMES_VEC(a) NULL, 0
+#define NAMES_IVEC(a) NULL, 0
+#define NAMES_SCALE(a) NULL, 0
+#define NAMES_MAP(a) NULL, 0
+#define NAMES_LIST(a) NULL, 0
+#define NAMES_VLIST(a) NULL, 0
+#define NAMES_ILIST(a) NULL, 0
+#define NAMES_IDXLIST(a) NULL, 0
+
+const cs_scene_key cs_scene_keys[CS_KEY_COUNT] = {
+#define CS_SECTION(sec, ttype, tname, heading)
+#define CS_KEY(sec, key, TYPE, ARG, REQ, DEF, DEFTEXT, RANGE, UNIT, HOW, FIELD, DOC)          \
+    {CS_SEC_##sec, #key, CS_KT_##TYPE, N_##TYPE(ARG), CHILD_##TYPE(ARG), NAMES_##TYPE(ARG), \
+     CS_IS_##REQ, RAW_##TYPE(sec, key), HASDEF_##DEF ? def_##sec##_##key : NULL, DEFTEXT,    \
+     RANGE_##RANGE, UNIT, TARGET_##HOW(sec, FIELD), DOC},
+#define CS_END(sec)
+#define CS_IS_OPT false
+#define CS_IS_REQ true
+#include "import/scene_keys.def"
+#undef CS_SECTION
+#undef CS_KEY
+#undef CS_END
+};
+
+const cs_scene_section cs_scene_sections[CS_SEC_COUNT] = {
+#define CS_SECTION(sec, ttype, tname, heading) {#sec, tname, heading, sec##_fields},
+#define CS_KEY(sec, key, TYPE, ARG, REQ, DEF, DEFTEXT, RANGE, UNIT, HOW, FIELD, DOC)
+#define CS_END(sec)
+#include "import/scene_keys.def"
+#undef CS_SECTION
+#undef CS_KEY
+#undef CS_END
+};
+
+const char *cs_scene_enum_name(const cs_scene_key *k, int v)
+{
+    for (unsigned i = 0; i < k->nnames; i++)
+        if (k->names[i].val == v)
+            return k->names[i].str;
+    return "?";
+}
+
+bool cs_key_in_range(const cs_key_range *r, double x)
+{
+    if (r->lo_kind == CS_BOUND_GT && !(x > r->lo))
+        return false;
+    if (r->lo_kind == CS_BOUND_GE && !(x >= r->lo))
+        return false;
+    if (r->hi_kind == CS_BOUND_GT && !(x < r->hi))
+        return false;
+    if (r->hi_kind == CS_BOUND_GE && !(x <= r->hi))
+        return false;
+    return true;
+}
+
+void cs_key_range_text(const cs_key_range *r, char *buf, size_t len)
+{
+    if (r->lo_kind == CS_BOUND_NONE && r->hi_kind == CS_BOUND_NONE)
+        snprintf(buf, len, "%s", "");
+    else if (r->hi_kind == CS_BOUND_NONE)
+        snprintf(buf, len, "%s %g", r->lo_kind == CS_BOUND_GT ? ">" : ">=", r->lo);
+    else if (r->lo_kind == CS_BOUND_NONE)
+        snprintf(buf, len, "%s %g", r->hi_kind == CS_BOUND_GT ? "<" : "<=", r->hi);
+    else
+        snprintf(buf, len, "in %c%g, %g%c", r->lo_kind == CS_BOUND_GT ? '(' : '[', r->lo, r->hi,
+                 r->hi_kind == CS_BOUND_GT ? ')' : ']');
+}
+
+/* Edit distance with adjacent transpositions (optimal string alignment). */
+static int edit_distance(const char *a, const char *b)
+{
+    enum { MAX = 64 };
+    size_t n = strlen(a), m = strlen(b);
+    if (n >= MAX || m >= MAX)
+        return MAX;
+    int d[MAX][MAX];
+    for (size_t i = 0; i <= n; i++)
+        d[i][0] = (int)i;
+    for (size_t j = 0; j <= m; j++)
+        d[0][j] = (int)j;
+    for (size_t i = 1; i <= n; i++)
+        for (size_t j = 1; j <= m; j++) {
+            int cost = a[i - 1] != b[j - 1];
+            int best = d[i - 1][j - 1] + cost;
+            if (d[i - 1][j] + 1 < best)
+                best = d[i - 1][j] + 1;
+            if (d[i][j - 1] + 1 < best)
+                best = d[i][j - 1] + 1;
+            if (i > 1 && j > 1 && a[i - 1] == b[j - 2] && a[i - 2] == b[j - 1] &&
+                d[i - 2][j - 2] + 1 < best)
+                best = d[i - 2][j - 2] + 1;
+            d[i][j] = best;
+        }
+    return d[n][m];
+}
+
+const char *cs_scene_nearest_key(const cyaml_schema_value_t *mapping, const char *key)
+{
+    if (!mapping || mapping->type != CYAML_MAPPING)
+        return NULL;
+    const char *best = NULL;
+    /* near: a third of the key's letters wrong at the most (one for short keys) */
+    int best_d = (int)(strlen(key) + 2) / 3 + 1;
+    for (const cyaml_schema_field_t *f = mapping->mapping.fields; f->key; f++) {
+        int d = edit_distance(key, f->key);
+        if (d < best_d) {
+            best = f->key;
+            best_d = d;
+        }
+    }
+    return best;
+}
 
 /* ------------------------------------------------------------ key paths */
 
@@ -367,13 +406,27 @@ const cyaml_schema_value_t *cs_scene_schema_at(const cs_spath *p)
     return v;
 }
 
+/* The value of a DT key (a string in the schema only so that "auto" loads). */
+static bool is_auto_number(const cyaml_schema_value_t *v)
+{
+    for (int k = 0; k < CS_KEY_COUNT; k++) {
+        if (cs_scene_keys[k].type != CS_KT_DT)
+            continue;
+        const cyaml_schema_field_t *f = cs_scene_sections[cs_scene_keys[k].section].fields;
+        for (; f->key; f++)
+            if (v == &f->value && strcmp(f->key, cs_scene_keys[k].key) == 0)
+                return true;
+    }
+    return false;
+}
+
 void cs_scene_schema_describe(const cyaml_schema_value_t *v, char *buf, size_t len)
 {
     if (!v) {
         snprintf(buf, len, "a valid value");
         return;
     }
-    if (v == DT_VALUE) {
+    if (is_auto_number(v)) {
         snprintf(buf, len, "a number >= 0 or auto");
         return;
     }

@@ -2,8 +2,9 @@
  *
  * The raw structs libcyaml fills from a scene file, the schema that drives
  * it, and small queries on that schema (the schema of a key path, a phrase
- * for what a value should look like). Optional scalars are pointers so that
- * an explicit 0 differs from an absent key (NULL).
+ * for what a value should look like), all made from the table of keys,
+ * scene_keys.def. Optional scalars are pointers so that an explicit 0
+ * differs from an absent key (NULL).
  */
 #ifndef CS_SCENE_SCHEMA_H
 #define CS_SCENE_SCHEMA_H
@@ -13,174 +14,126 @@
 
 #include <cyaml/cyaml.h>
 
-typedef struct cs_raw_time {
-    double *fps;
-    int *frames;
-    char *dt;                  /* a number or "auto": checked after loading */
-    double *dt_safety;
-    int *collision_steps;
-    double *cg_tolerance;
-    int *cg_max_iterations;
-} cs_raw_time;
+/* The raw structs, one per section of scene_keys.def: an optional scalar
+ * is a pointer, a list a pointer and a count (<key>_count). */
+#define CS_SECTION(sec, ttype, tname, heading) typedef struct cs_raw_##sec cs_raw_##sec;
+#define CS_KEY(sec, key, TYPE, ARG, REQ, DEF, DEFTEXT, RANGE, UNIT, HOW, FIELD, DOC)
+#define CS_END(sec)
+#include "import/scene_keys.def"
+#undef CS_SECTION
+#undef CS_KEY
+#undef CS_END
 
-typedef struct cs_raw_effects {
-    bool *bodies;
-    bool *wind;
-    bool *self_collision;
-    int *friction;             /* cs_friction_method */
-} cs_raw_effects;
+#define CS_RAW_NUM_OPT(k, a) double *k;
+#define CS_RAW_NUM_REQ(k, a) double k;
+#define CS_RAW_INT_OPT(k, a) int *k;
+#define CS_RAW_BOOL_OPT(k, a) bool *k;
+#define CS_RAW_STR_OPT(k, a) char *k;
+#define CS_RAW_DT_OPT(k, a) char *k;     /* a number or "auto": read on conversion */
+#define CS_RAW_ENUM_OPT(k, a) int *k;
+#define CS_RAW_ENUM_REQ(k, a) int k;
+#define CS_RAW_VEC_OPT(k, a) double *k;
+#define CS_RAW_VEC_REQ(k, a) double *k;
+#define CS_RAW_IVEC_OPT(k, a) int *k;
+#define CS_RAW_SCALE_OPT(k, a)          /* read from the document */
+#define CS_RAW_MAP_OPT(k, a) struct cs_raw_##a *k;
+#define CS_RAW_MAP_REQ(k, a) struct cs_raw_##a *k;
+#define CS_RAW_LIST_OPT(k, a) struct cs_raw_##a *k; unsigned k##_count;
+#define CS_RAW_LIST_REQ(k, a) CS_RAW_LIST_OPT(k, a)
+#define CS_RAW_VLIST_OPT(k, a) double (*k)[a]; unsigned k##_count;
+#define CS_RAW_ILIST_OPT(k, a) int (*k)[a]; unsigned k##_count;
+#define CS_RAW_IDXLIST_OPT(k, a) int *k; unsigned k##_count;
+#define CS_SECTION(sec, ttype, tname, heading) struct cs_raw_##sec {
+#define CS_KEY(sec, key, TYPE, ARG, REQ, DEF, DEFTEXT, RANGE, UNIT, HOW, FIELD, DOC) \
+    CS_RAW_##TYPE##_##REQ(key, ARG)
+#define CS_END(sec) };
+#include "import/scene_keys.def"
+#undef CS_SECTION
+#undef CS_KEY
+#undef CS_END
 
-typedef struct cs_raw_self {
-    double *thickness;
-    double *stiffness;
-    double *friction;
-    double *edge_flip_epsilon;
-    int *zone_iterations;
-    int *scheme;               /* cs_collision_scheme */
-    bool *verify;
-} cs_raw_self;
+/* ------------------------------------------------------ key descriptors */
 
-typedef struct cs_raw_wind {
-    double *velocity;          /* 3 */
-    double *drag;
-} cs_raw_wind;
+/* Sections and keys by name: CS_SEC_time, CS_KEY_time_fps. */
+enum {
+#define CS_SECTION(sec, ttype, tname, heading) CS_SEC_##sec,
+#define CS_KEY(sec, key, TYPE, ARG, REQ, DEF, DEFTEXT, RANGE, UNIT, HOW, FIELD, DOC)
+#define CS_END(sec)
+#include "import/scene_keys.def"
+#undef CS_SECTION
+#undef CS_KEY
+#undef CS_END
+    CS_SEC_COUNT
+};
+enum {
+#define CS_SECTION(sec, ttype, tname, heading)
+#define CS_KEY(sec, key, TYPE, ARG, REQ, DEF, DEFTEXT, RANGE, UNIT, HOW, FIELD, DOC) \
+    CS_KEY_##sec##_##key,
+#define CS_END(sec)
+#include "import/scene_keys.def"
+#undef CS_SECTION
+#undef CS_KEY
+#undef CS_END
+    CS_KEY_COUNT
+};
 
-typedef struct cs_raw_output {
-    int *format;               /* index into cs_scene_format_names */
-} cs_raw_output;
+typedef enum cs_key_type {
+    CS_KT_NUM, CS_KT_INT, CS_KT_BOOL, CS_KT_STR, CS_KT_DT, CS_KT_ENUM, CS_KT_VEC, CS_KT_IVEC,
+    CS_KT_SCALE, CS_KT_MAP, CS_KT_LIST, CS_KT_VLIST, CS_KT_ILIST, CS_KT_IDXLIST,
+} cs_key_type;
 
-typedef struct cs_raw_camera {
-    double *position;          /* 3, required */
-    double *target;            /* 3, required */
-    double *up;                /* 3 */
-    double *fov;
-} cs_raw_camera;
+/* Bound kinds: lo GT is "> lo", GE ">= lo"; hi GT is "< hi", GE "<= hi". */
+enum { CS_BOUND_NONE, CS_BOUND_GT, CS_BOUND_GE };
 
-typedef struct cs_raw_grid {
-    double *size;              /* 2 */
-    int *resolution;           /* 2 */
-    double *center;            /* 3 */
-    double *rotation;          /* 3, degrees */
-} cs_raw_grid;
+typedef struct cs_key_range {
+    int lo_kind;
+    double lo;
+    int hi_kind;
+    double hi;
+} cs_key_range;
 
-typedef struct cs_raw_mesh {
-    char *file;                /* a mesh file, relative to the scene's folder */
-    char *node;                /* a node or mesh of that file */
-    int *units;                /* index into cs_scene_unit_names */
-    /* scale: a number or 3 numbers, read from the document (cyaml has no
-     * either-or type) */
-    double (*vertices)[3];
-    unsigned vertices_count;
-    int (*triangles)[3];
-    unsigned triangles_count;
-    double *rotation;          /* 3, degrees */
-    double *translate;         /* 3 */
-} cs_raw_mesh;
+typedef struct cs_scene_key {
+    int section;                 /* CS_SEC_... */
+    const char *key;
+    cs_key_type type;
+    int n;                       /* entries of a VEC, IVEC, VLIST, ILIST */
+    int child;                   /* MAP, LIST: the section; else -1 */
+    const cyaml_strval_t *names; /* ENUM */
+    unsigned nnames;
+    bool required;
+    size_t raw;                  /* offset in cs_raw_<section> (not for SCALE) */
+    double (*def)(int i);        /* the default (entry i of a vector); NULL: none */
+    const char *deftext;         /* what the reference says instead, or NULL */
+    cs_key_range range;
+    const char *unit;
+    long target;                 /* offset into the section's ttype; -1: by hand */
+    const char *doc;
+} cs_scene_key;
 
-typedef struct cs_raw_material {
-    double *edge_stiffness;
-    double *edge_overdamping;
-    double *bend_stiffness;
-    double *bend_overdamping;
-    double *node_mass;
-    double *density;
-} cs_raw_material;
+typedef struct cs_scene_section {
+    const char *name;            /* e.g. "self" */
+    const char *tname;           /* "mapping", "selection", "motion" */
+    const char *heading;         /* e.g. "self_collision" */
+    const cyaml_schema_field_t *fields;
+} cs_scene_section;
 
-typedef struct cs_raw_box {
-    double *min;               /* 3, required */
-    double *max;               /* 3, required */
-} cs_raw_box;
+extern const cs_scene_key cs_scene_keys[CS_KEY_COUNT];
+extern const cs_scene_section cs_scene_sections[CS_SEC_COUNT];
+#define CS_SKEY(sec, key) (&cs_scene_keys[CS_KEY_##sec##_##key])
 
-typedef struct cs_raw_selection {
-    int *vertices;
-    unsigned vertices_count;
-    cs_raw_box *box;
-    int (*grid_points)[2];
-    unsigned grid_points_count;
-} cs_raw_selection;
+bool cs_key_in_range(const cs_key_range *r, double x);
+/* "> 0", "in (0, 1]", "" for no bound. */
+void cs_key_range_text(const cs_key_range *r, char *buf, size_t len);
 
-typedef struct cs_raw_key {
-    double time;               /* required */
-    double *translate;         /* 3 */
-    double *rotate;            /* 3, degrees */
-} cs_raw_key;
-
-typedef struct cs_raw_motion {
-    double *velocity;          /* 3 */
-    double *angular_velocity;  /* 3, rad/s */
-    cs_raw_key *keys;
-    unsigned keys_count;
-} cs_raw_motion;
-
-typedef struct cs_raw_script {
-    cs_raw_selection *select;  /* required */
-    double *pivot;             /* 3 */
-    cs_raw_motion *motion;
-} cs_raw_script;
-
-typedef struct cs_raw_cloth {
-    char *name;
-    double *color;             /* 3 */
-    cs_raw_grid *grid;
-    cs_raw_mesh *mesh;
-    cs_raw_material *material;
-    double *velocity;          /* 3 */
-    cs_raw_selection *pins;
-    unsigned pins_count;
-    cs_raw_script *scripts;
-    unsigned scripts_count;
-} cs_raw_cloth;
-
-typedef struct cs_raw_body {
-    char *name;
-    int shape;                 /* cs_body_shape, required */
-    double *position;          /* 3 */
-    double *rotation;          /* 3, degrees */
-    double *normal;            /* 3, planes only */
-    double *radius;
-    double *size;              /* 3 */
-    double *height;
-    double *friction;
-    double *collision_offset;
-    double *color;             /* 3 */
-    cs_raw_motion *motion;
-    cs_raw_mesh *mesh;         /* mesh bodies */
-    double *voxel_size;
-    double *band;
-    bool *close_holes;
-    int *interior;             /* cs_interior_mode */
-} cs_raw_body;
-
-typedef struct cs_raw_levelset {
-    char *cache;               /* a folder, or "none" */
-} cs_raw_levelset;
-
-typedef struct cs_raw_scene {
-    char *name;
-    char *description;
-    cs_raw_time *time;
-    double *gravity;           /* 3 */
-    cs_raw_effects *effects;
-    cs_raw_self *self_collision;
-    cs_raw_wind *wind;
-    cs_raw_output *output;
-    cs_raw_camera *camera;
-    cs_raw_cloth *cloths;
-    unsigned cloths_count;
-    cs_raw_body *bodies;
-    unsigned bodies_count;
-    cs_raw_levelset *levelset;
-} cs_raw_scene;
+/* The known key of the mapping with this schema nearest to key (edit
+ * distance, a transposition counting once), or NULL when none is near. */
+const char *cs_scene_nearest_key(const cyaml_schema_value_t *mapping, const char *key);
 
 /* The top-level schema (a pointer to cs_raw_scene). */
 extern const cyaml_schema_value_t cs_scene_schema;
 
-/* Output format names, indexed by cs_raw_output.format. */
-extern const char *const cs_scene_format_names[];
-
-/* Mesh units, indexed by cs_raw_mesh.units; 0 is "auto". */
-extern const char *const cs_scene_unit_names[];
-#define CS_SCENE_UNIT_COUNT 7
+/* The name of value v of an ENUM key. */
+const char *cs_scene_enum_name(const cs_scene_key *k, int v);
 
 /* A key path: mapping keys and sequence indices, outermost first. Keys
  * longer than the buffer are cut (they then match nothing). */

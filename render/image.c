@@ -6,6 +6,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "common/util.h"
 #include "render/internal.h"
 
 void cs_render_error(char *err, size_t errlen, const char *fmt, ...)
@@ -97,50 +98,49 @@ cs_image *cs_image_shrink(const cs_image *src, int width)
     return dst;
 }
 
-int cs_image_write_png(const cs_image *img, const char *path, char *err, size_t errlen)
+/* The image as the PNG file tmp (libpng checks its writes and fclose). */
+static int fill_png(const char *tmp, void *ctx, char *why, size_t whylen)
 {
-    if (!img || !img->rgb || !path || !*path) {
-        cs_render_error(err, errlen, "cs_image_write_png: no image or no file name");
-        return CS_RENDER_FAILED;
-    }
-    size_t len = strlen(path);
-    char *tmp = malloc(len + 5);
-    if (!tmp) {
-        cs_render_error(err, errlen, "cannot write %s: out of memory", path);
-        return CS_RENDER_NOMEM;
-    }
-    memcpy(tmp, path, len);
-    memcpy(tmp + len, ".tmp", 5);
-
-    /* libpng reports a failed fopen only as "could not open file": ask the
-     * system first for a useful reason. */
-    FILE *probe = fopen(tmp, "wb");
-    if (!probe) {
-        cs_render_error(err, errlen, "cannot write %s: %s", tmp, strerror(errno));
-        free(tmp);
-        return CS_RENDER_FAILED;
-    }
-    fclose(probe);
-
+    const cs_image *img = ctx;
     png_image png;
     memset(&png, 0, sizeof png);
     png.version = PNG_IMAGE_VERSION;
     png.width = (png_uint_32)img->width;
     png.height = (png_uint_32)img->height;
     png.format = PNG_FORMAT_RGB;
-    int rc = CS_RENDER_OK;
-    if (!png_image_write_to_file(&png, tmp, 0, img->rgb, 3 * img->width, NULL)) {
-        cs_render_error(err, errlen, "cannot write %s: %s", tmp, png.message);
-        rc = CS_RENDER_FAILED;
-    } else if (rename(tmp, path) != 0) {
-        cs_render_error(err, errlen, "cannot rename %s to %s: %s", tmp, path, strerror(errno));
-        rc = CS_RENDER_FAILED;
+    /* libpng reports a failed fopen only as "could not open file": open it
+     * here for the system's reason. */
+    errno = 0;
+    FILE *fp = fopen(tmp, "wb");
+    if (!fp) {
+        snprintf(why, whylen, "%s", strerror(errno));
+        return -1;
     }
+    int ok = png_image_write_to_stdio(&png, fp, 0, img->rgb, 3 * img->width, NULL);
+    if (!ok)
+        snprintf(why, whylen, "%s", png.message);
     png_image_free(&png);
-    if (rc != CS_RENDER_OK)
-        remove(tmp);
-    free(tmp);
-    return rc;
+    errno = 0;
+    if (ok && (fflush(fp) != 0 || ferror(fp))) {
+        snprintf(why, whylen, "%s", strerror(errno ? errno : EIO));
+        ok = 0;
+    }
+    if (fclose(fp) != 0 && ok) {
+        snprintf(why, whylen, "%s", strerror(errno ? errno : EIO));
+        ok = 0;
+    }
+    return ok ? 0 : -1;
+}
+
+int cs_image_write_png(const cs_image *img, const char *path, char *err, size_t errlen)
+{
+    if (!img || !img->rgb || !path || !*path) {
+        cs_render_error(err, errlen, "cs_image_write_png: no image or no file name");
+        return CS_RENDER_FAILED;
+    }
+    return cs_write_atomic(path, false, fill_png, (void *)img, err, errlen) == 0
+               ? CS_RENDER_OK
+               : CS_RENDER_FAILED;
 }
 
 cs_image *cs_image_read_png(const char *path, char *err, size_t errlen)

@@ -7,6 +7,7 @@
 #include <time.h>
 
 #include "render/internal.h"
+#include "common/util.h"
 
 struct cs_renderer {
     cs_render_settings settings;
@@ -109,11 +110,6 @@ void cs_renderer_destroy(cs_renderer *r)
     cs_embree_destroy(r->embree);
     cs_preview_destroy(r->preview);
     free(r);
-}
-
-const cs_render_settings *cs_renderer_settings(const cs_renderer *r)
-{
-    return &r->settings;
 }
 
 /* ------------------------------------------------------------ input checks */
@@ -255,18 +251,11 @@ static void free_prepared(cs_prepared_scene *p)
     free(p->meshes);
 }
 
-static double now_seconds(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
-
 int cs_renderer_draw(cs_renderer *r, int nmeshes, const cs_render_mesh *meshes,
                      const cs_render_camera *camera, cs_image *image, cs_render_stats *stats,
                      char *err, size_t errlen)
 {
-    double t0 = now_seconds();
+    double t0 = cs_now();
     cs_render_stats local;
     if (!stats)
         stats = &local;
@@ -335,7 +324,7 @@ int cs_renderer_draw(cs_renderer *r, int nmeshes, const cs_render_mesh *meshes,
     else
         rc = cs_preview_draw(r->preview, &p, camera, image, stats, err, errlen);
     free_prepared(&p);
-    stats->seconds = now_seconds() - t0;
+    stats->seconds = cs_now() - t0;
     if (rc == CS_RENDER_OK && stats->covered == 0) {
         cs_render_error(err, errlen,
                         "the camera sees nothing: no mesh is in its view (camera at (%g, %g, "

@@ -162,7 +162,6 @@ typedef struct cs_renderer cs_renderer;
 
 cs_renderer *cs_renderer_create(const cs_render_settings *settings, char *err, size_t errlen);
 void cs_renderer_destroy(cs_renderer *renderer);
-const cs_render_settings *cs_renderer_settings(const cs_renderer *renderer);
 
 /* Draws the meshes into image (its size must be the settings' size). Bad
  * input: no mesh, a mesh with no triangles, an index out of range, a

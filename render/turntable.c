@@ -10,6 +10,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include "common/util.h"
 #include "render/internal.h"
 
 extern char **environ;
@@ -30,6 +31,16 @@ static cairo_surface_t *surface_of(const cs_image *img)
     }
     cairo_surface_mark_dirty(s);
     return s;
+}
+
+/* The sheet as the PNG file tmp. */
+static int fill_sheet(const char *tmp, void *ctx, char *why, size_t whylen)
+{
+    cairo_status_t st = cairo_surface_write_to_png(ctx, tmp);
+    if (st == CAIRO_STATUS_SUCCESS)
+        return 0;
+    snprintf(why, whylen, "%s", cairo_status_to_string(st));
+    return -1;
 }
 
 int cs_render_contact_sheet(const char *path, int nimages, const cs_image *const *images,
@@ -93,29 +104,8 @@ int cs_render_contact_sheet(const char *path, int nimages, const cs_image *const
     if (st != CAIRO_STATUS_SUCCESS) {
         cs_render_error(err, errlen, "contact sheet: cairo: %s", cairo_status_to_string(st));
         rc = CS_RENDER_FAILED;
-    } else {
-        size_t len = strlen(path);
-        char *tmp = malloc(len + 5);
-        if (!tmp) {
-            cs_render_error(err, errlen, "out of memory");
-            rc = CS_RENDER_NOMEM;
-        } else {
-            memcpy(tmp, path, len);
-            memcpy(tmp + len, ".tmp", 5);
-            st = cairo_surface_write_to_png(sheet, tmp);
-            if (st != CAIRO_STATUS_SUCCESS) {
-                cs_render_error(err, errlen, "cannot write %s: %s", tmp,
-                                cairo_status_to_string(st));
-                rc = CS_RENDER_FAILED;
-                remove(tmp);
-            } else if (rename(tmp, path) != 0) {
-                cs_render_error(err, errlen, "cannot rename %s to %s: %s", tmp, path,
-                                strerror(errno));
-                rc = CS_RENDER_FAILED;
-                remove(tmp);
-            }
-            free(tmp);
-        }
+    } else if (cs_write_atomic(path, false, fill_sheet, sheet, err, errlen) != 0) {
+        rc = CS_RENDER_FAILED;
     }
     cairo_surface_destroy(sheet);
     return rc;

@@ -3,6 +3,7 @@
 #include "sim/par.h"
 
 #include "sim/internal.h"
+#include "common/util.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -11,18 +12,11 @@
 
 #include <omp.h>
 
-static double now(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
-
 /* Charges a communication to the current stage. */
 static void charge(cs_par *p, double t0, long bytes, long messages)
 {
     cs_comm_stats *c = p->stats + p->stage;
-    c->seconds += now() - t0;
+    c->seconds += cs_now() - t0;
     c->bytes += bytes;
     c->messages += messages;
 }
@@ -194,7 +188,22 @@ int cs_halo_from_needs(const cs_par *p, int nneeds, const int *user, const int *
     return rc;
 }
 
-cs_par *cs_par_create(MPI_Comm comm, int n, const double *x, int nsprings, const int *ends)
+/* The MPI communicator a cs_comm names (MPI initialised). */
+static MPI_Comm mpi_comm(cs_comm comm)
+{
+    switch (comm) {
+    case CS_COMM_WORLD:
+        return MPI_COMM_WORLD;
+    case CS_COMM_SELF:
+        return MPI_COMM_SELF;
+    case CS_COMM_NONE:
+        return MPI_COMM_NULL;
+    default:
+        return comm >= 0 ? MPI_Comm_f2c(comm) : MPI_COMM_NULL;
+    }
+}
+
+cs_par *cs_par_create(cs_comm handle, int n, const double *x, int nsprings, const int *ends)
 {
     cs_par *p = calloc(1, sizeof *p);
     if (!p)
@@ -206,7 +215,8 @@ cs_par *cs_par_create(MPI_Comm comm, int n, const double *x, int nsprings, const
     MPI_Finalized(&finalised);
     p->comm = MPI_COMM_NULL;
     p->sum_max = MPI_OP_NULL;
-    if (initialised && !finalised && comm != MPI_COMM_NULL) {
+    MPI_Comm comm = initialised && !finalised ? mpi_comm(handle) : MPI_COMM_NULL;
+    if (comm != MPI_COMM_NULL) {
         /* our own communicator: the simulation's messages never match the
          * caller's */
         if (MPI_Comm_dup(comm, &p->comm) != MPI_SUCCESS) {
@@ -333,7 +343,7 @@ static void exchange(cs_par *p, const cs_halo *h, double *a, int width, bool rev
 {
     if (!p->mpi || h->nlinks == 0)
         return;
-    double t0 = now();
+    double t0 = cs_now();
     size_t total = 0;
     for (int l = 0; l < h->nlinks; l++)
         total += (size_t)(h->link[l].nsend + h->link[l].nrecv) * (size_t)width;
@@ -392,7 +402,7 @@ static void gather(cs_par *p, double *a, int width, bool to_all)
 {
     if (!p->mpi || p->size == 1)
         return;
-    double t0 = now();
+    double t0 = cs_now();
     double *buf = buffer(p, (size_t)width * (size_t)p->n + (size_t)width * p->nowned + 1);
     double *mine = buf + (size_t)width * (size_t)p->n;
     const int *ids = p->order + p->displs[p->rank];
@@ -430,7 +440,7 @@ static void reduce(cs_par *p, void *a, int count, MPI_Datatype type, MPI_Op op, 
 {
     if (!p->mpi || p->size == 1)
         return;
-    double t0 = now();
+    double t0 = cs_now();
     MPI_Allreduce(MPI_IN_PLACE, a, count, type, op, p->comm);
     charge(p, t0, (long)size * count, 1);
 }
@@ -465,7 +475,7 @@ int cs_par_allgather_items(cs_par *p, const void *items, int count, size_t size,
         *nout = count;
         return 0;
     }
-    double t0 = now();
+    double t0 = cs_now();
     int *counts = malloc(sizeof *counts * 2 * ((size_t)p->size + 1));
     if (!counts)
         return -1;
@@ -630,7 +640,7 @@ void cs_par_sum_max(cs_par *p, double *sum, double *max)
 {
     if (!p->mpi || p->size == 1)
         return;
-    double t0 = now();
+    double t0 = cs_now();
     if (p->sum_max == MPI_OP_NULL)
         MPI_Op_create(sum_max_op, 1, &p->sum_max);
     double pair[2] = {*sum, *max};

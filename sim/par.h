@@ -7,7 +7,7 @@
  * does not own are its ghosts, refreshed from their owners, neighbours
  * only. Loops walk index ranges (CS_FOR_OWNED, CS_FOR_LOCAL), so one rank
  * is the same code with one range [0, n) and no messages: a simulation
- * made without MPI initialised, or with MPI_COMM_NULL, is one rank.
+ * made without MPI initialised, or with CS_COMM_NONE, is one rank.
  *
  * Keeping global arrays costs O(n) memory per rank; the paper synchronises
  * every position to every processor for its collision hierarchies anyway,
@@ -66,7 +66,7 @@ typedef struct cs_par {
 /* Partitions n particles at positions x by recursive median split over
  * the ranks of comm; springs (2 ends each) decide the ghosts. Returns NULL
  * when memory runs out. */
-cs_par *cs_par_create(MPI_Comm comm, int n, const double *x, int nsprings, const int *ends);
+cs_par *cs_par_create(cs_comm comm, int n, const double *x, int nsprings, const int *ends);
 void cs_par_destroy(cs_par *p);
 
 /* Recursive median split (exposed for tests): owner[i] in [0, parts) for

@@ -9,6 +9,7 @@
 #include <time.h>
 
 #include "sim/internal.h"
+#include "common/util.h"
 #include "sim/vec3.h"
 
 cs_cloth_material cs_default_cloth_material(void)
@@ -53,23 +54,16 @@ cs_sim_def cs_default_sim_def(void)
     d.bodies_enabled = true;
     d.wind_enabled = false;
     d.self = cs_default_self_collision_def();
-    d.comm = MPI_COMM_WORLD;
+    d.comm = CS_COMM_WORLD;
     return d;
 }
 
-static double now(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
-
 #define STAGE_BEGIN(sim, stage)                                        \
-    double stage_t0_##stage = now();                                   \
+    double stage_t0_##stage = cs_now();                                \
     cs_par_begin((sim)->par, stage)
 #define STAGE_END(sim, stage)                                          \
     do {                                                               \
-        (sim)->timing[stage].seconds += now() - stage_t0_##stage;      \
+        (sim)->timing[stage].seconds += cs_now() - stage_t0_##stage;   \
         (sim)->timing[stage].calls++;                                  \
     } while (0)
 
@@ -600,10 +594,10 @@ int cs_sim_step(cs_sim *sim, double dt)
         copy_ranges(par->own, par->nown, sim->v_star, sim->v);
     }
     { /* the ghosts' new positions, for the forces at x^(n+1/2): B.3's messages */
-        double t0 = now();
+        double t0 = cs_now();
         cs_par_begin(par, CS_STAGE_POSITION_UPDATE);
         cs_halo_forward(par, &par->ghosts, sim->x, 3);
-        sim->timing[CS_STAGE_POSITION_UPDATE].seconds += now() - t0;
+        sim->timing[CS_STAGE_POSITION_UPDATE].seconds += cs_now() - t0;
     }
 
     /* B.5 and B.6: v^(n+1/2) = v*^n + dt/2 a(x^(n+1/2), v^(n+1/2)) with the

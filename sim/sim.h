@@ -13,11 +13,19 @@
 #include <stdbool.h>
 #include <stddef.h>
 
-#include <mpi.h>
-
 #ifdef __cplusplus
 extern "C" {
 #endif
+
+/* Section 7: the ranks that share a simulation, an MPI communicator named
+ * without <mpi.h> (MPI stays inside sim/par.c): CS_COMM_WORLD
+ * (MPI_COMM_WORLD), CS_COMM_SELF (this process alone), CS_COMM_NONE
+ * (MPI_COMM_NULL: one rank, no MPI call), or any other communicator c as
+ * MPI's own integer handle for it, MPI_Comm_c2f(c) (never negative). */
+typedef int cs_comm;
+#define CS_COMM_WORLD (-1)
+#define CS_COMM_SELF (-2)
+#define CS_COMM_NONE (-3)
 
 /* ---------------------------------------------------------------- status */
 
@@ -238,11 +246,11 @@ typedef struct cs_sim_def {
     const cs_cloth_def *cloths;
     int nbodies;
     const cs_body_def *bodies;
-    /* Section 7: the ranks that share the simulation (MPI_COMM_WORLD by
+    /* Section 7: the ranks that share the simulation (CS_COMM_WORLD by
      * default). Every rank makes the same calls with the same definition.
-     * Without MPI initialised, or with MPI_COMM_NULL, it is one rank and
+     * Without MPI initialised, or with CS_COMM_NONE, it is one rank and
      * makes no MPI call. */
-    MPI_Comm comm;
+    cs_comm comm;
     /* Only the plan and the step size are wanted (clothsim run --plan):
      * particles, masses and springs are built for Lanczos, and nothing the
      * step needs (scratch, solver, contacts, self-collision, partition) is

@@ -77,7 +77,8 @@ check_png pv/frame_0000.png 40x30
 check_png pv/frame_0002.png 40x30
 [ ! -e pv/frame_0001.png ] || fail "--frames 0,2 rendered frame 1"
 
-# --- two cloths written as OBJ (renumbered vertices): split back by triangles
+# --- two cloths: each read back by its name (OBJ and glb: an object per
+# cloth; PLY: a file per cloth), never guessed
 cat >two.yaml <<'EOF2'
 cloths:
   - {name: a, grid: {size: [0.4, 0.4], resolution: [3, 3], center: [-0.3, 0.5, 0]}}
@@ -91,6 +92,24 @@ check_png two/images/frame_0001.png 40x30
 if grep -q 'one mesh' err.txt; then
     fail "an OBJ frame of two cloths was drawn as one mesh"
 fi
+run 0 run two.yaml -q -o twoglb --format glb
+run 0 render twoglb --size 40x30 --samples 1 --frames last
+check_png twoglb/images/frame_0001.png 40x30
+! grep -q 'one mesh' err.txt || fail "a glb frame of two cloths was drawn as one mesh"
+run 0 run two.yaml -q -o twoply
+for f in frame_0000.a.ply frame_0000.b.ply frame_0001.a.ply frame_0001.b.ply; do
+    [ -s "twoply/frames/$f" ] || fail "twoply/frames/$f: no file per cloth"
+done
+[ ! -e twoply/frames/frame_0001.ply ] || fail "a PLY frame of two cloths was merged"
+run 0 render twoply --size 40x30 --samples 1
+check_png twoply/images/frame_0001.png 40x30
+# cloths renamed since the run: no object of their names, drawn as one mesh
+run 0 render two --size 40x30 --samples 1 --frames 1 --set cloths.0.name=c --set cloths.1.name=d
+err_has "all cloth is drawn as one mesh"
+# a cloth's file missing
+rm twoply/frames/frame_0001.b.ply
+run 2 render twoply --frames 1 --size 40x30 --samples 1
+err_has "frame_0001.b.ply: no such frame file"
 
 # --- a scene file: its initial state
 run 0 render tiny.yaml --size 32x24 --samples 1 -q

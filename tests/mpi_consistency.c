@@ -97,7 +97,7 @@ static void trajectory_free(trajectory *t)
 static trajectory run(const cs_scene *scene, MPI_Comm comm, int frames)
 {
     cs_sim_def def = scene->def;
-    def.comm = comm;
+    def.comm = MPI_Comm_c2f(comm);
     char err[512];
     cs_sim *sim = cs_sim_create(&def, err, sizeof err);
     if (!sim) {

@@ -197,6 +197,36 @@ static void test_vertex_order_kept(void **state)
     }
 }
 
+/* Each view is an object of its own in OBJ and glb: read back by name,
+ * whatever the order asked; a name the file lacks is refused. */
+static void test_read_named(void **state)
+{
+    (void)state;
+    fixture f;
+    make_fixture(&f);
+    const cs_mesh_format formats[2] = {CS_MESH_OBJ, CS_MESH_GLB};
+    for (int i = 0; i < 2; i++) {
+        char name[32], path[512], err[512] = "";
+        snprintf(name, sizeof name, "named.%s", cs_mesh_format_extension(formats[i]));
+        path_in_dir(path, sizeof path, name);
+        assert_int_equal(cs_mesh_write(path, formats[i], 2, f.views, err, sizeof err),
+                         CS_IMPORT_OK);
+        const char *names[2] = {"tetra", "sheet"};
+        cs_trimesh *got[2] = {NULL, NULL};
+        if (cs_mesh_read_named(path, 2, names, got, err, sizeof err) != CS_IMPORT_OK)
+            fail_msg("read %s by name: %s", path, err);
+        assert_same_mesh(got[0], &f.views[1], 1);
+        assert_same_mesh(got[1], &f.views[0], 1);
+        cs_trimesh_destroy(got[0]);
+        cs_trimesh_destroy(got[1]);
+        const char *missing[2] = {"sheet", "nothing"};
+        assert_int_equal(cs_mesh_read_named(path, 2, missing, got, err, sizeof err),
+                         CS_IMPORT_BAD_INPUT);
+        assert_null(got[0]);
+        assert_non_null(strstr(err, "'nothing'"));
+    }
+}
+
 static void test_write_bad_path(void **state)
 {
     (void)state;
@@ -360,6 +390,7 @@ int main(void)
         cmocka_unit_test(test_obj),
         cmocka_unit_test(test_glb),
         cmocka_unit_test(test_vertex_order_kept),
+        cmocka_unit_test(test_read_named),
         cmocka_unit_test(test_write_bad_path),
         cmocka_unit_test(test_write_bad_input),
         cmocka_unit_test(test_points),

@@ -1,6 +1,7 @@
-/* test_scene.c: the YAML scene loader (import/scene.c): values and defaults
- * of a converted scene, one exact message per kind of error, --set
- * overrides, files, and the example in the README's scene reference. */
+/* test_scene.c: the YAML scene loader (import/scene_*.c, from the table of
+ * keys import/scene_keys.def): values and defaults of a converted scene,
+ * one exact message per kind of error, --set overrides, files, and the
+ * example in the README's scene reference. */
 #include <stdarg.h>
 #include <stddef.h>
 #include <stdint.h>
@@ -463,14 +464,25 @@ static void test_error_unknown_key(void **state)
                  "  fps: 24\n"
                  "  frames: 3\n"
                  "  fsp: 30\n",
-                 0, NULL, "scenes/a.yaml:7: time.fsp: unknown key");
+                 0, NULL, "scenes/a.yaml:7: time.fsp: unknown key; did you mean fps?");
     expect_error("cloths:\n"
                  "  - grid: {resolution: [2, 2]}\n"
                  "    material:\n"
                  "      node_mass: 1e-6\n"
                  "      stiffness: 3\n",
                  0, NULL, "scenes/a.yaml:5: cloths[0].material.stiffness: unknown key");
-    expect_error_after_grid("gravty: [0, -9.8, 0]\n", "scenes/a.yaml:3: gravty: unknown key");
+    expect_error_after_grid("gravty: [0, -9.8, 0]\n",
+                            "scenes/a.yaml:3: gravty: unknown key; did you mean gravity?");
+    /* the nearest known key is named (issue 11), a transposition counting once */
+    expect_error("cloths:\n"
+                 "  - grid:\n"
+                 "      resolutoin: [2, 2]\n",
+                 0, NULL,
+                 "scenes/a.yaml:3: cloths[0].grid.resolutoin: unknown key; did you mean "
+                 "resolution?");
+    expect_error("cloths:\n  - grid: {}\n    pins: [{box: {min: [0, 0, 0], maks: [1, 1, 1]}}]\n",
+                 0, NULL,
+                 "scenes/a.yaml:3: cloths[0].pins[0].box.maks: unknown key; did you mean max?");
     expect_error_after_grid("time: {fps: 24, fps: 30}\n",
                             "scenes/a.yaml:3: time.fps: duplicate key");
 }
@@ -675,7 +687,7 @@ static void test_override_errors(void **state)
     expect_override_error("gravity=[0, 0",
                           "--set gravity=[0, 0: the value is not valid YAML: did not find "
                           "expected ',' or ']'");
-    expect_override_error("time.fsp=3", "--set time.fsp=3: time.fsp: unknown key");
+    expect_override_error("time.fsp=3", "--set time.fsp=3: time.fsp: unknown key; did you mean fps?");
     expect_override_error("render.size=3", "--set render.size=3: render: unknown key");
     expect_override_error("cloths.2.name=x",
                           "--set cloths.2.name=x: index 2 is past the end of cloths (1 entry)");
@@ -725,7 +737,7 @@ static void test_override_keeps_file_lines(void **state)
                  "scenes/a.yaml:4: cloths[0].material.node_mass: must be > 0 (got -3)");
     /* ... and the file is checked before any override is applied */
     expect_error("cloths:\n  - grid: {}\ntime: {fsp: 3}\n", 1, ov,
-                 "scenes/a.yaml:3: time.fsp: unknown key");
+                 "scenes/a.yaml:3: time.fsp: unknown key; did you mean fps?");
     /* an override may repair a range error of the file */
     const char *fix[] = {"cloths.0.material.node_mass=3e-6"};
     cs_scene *s = load_ok(text, 1, fix);

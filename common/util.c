@@ -1,15 +1,22 @@
-/* fsutil.c: file-system helpers shared by the command's subcommands. */
+/* util.c: the helpers every folder shares (util.h). */
 #define _GNU_SOURCE /* syncfs */
-#include "app/fsutil.h"
+#include "common/util.h"
 
 #include <errno.h>
 #include <fcntl.h>
-#include <stdbool.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
+#include <time.h>
 #include <unistd.h>
+
+double cs_now(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
 
 int cs_make_dirs(const char *path)
 {
@@ -66,51 +73,65 @@ char *cs_path_tmp(const char *path)
     return tmp;
 }
 
-int cs_file_commit(FILE *fp, const char *tmp, const char *path, char *err, size_t errlen)
+int cs_write_atomic(const char *path, bool unique_tmp, cs_file_filler fill, void *ctx,
+                    char *err, size_t errlen)
 {
+    size_t len = strlen(path);
+    char *tmp = malloc(len + 32);
+    if (!tmp) {
+        snprintf(err, errlen, "cannot write %s: out of memory", path);
+        return -1;
+    }
+    if (unique_tmp) /* a name of this process's own */
+        snprintf(tmp, len + 32, "%s.tmp%ld", path, (long)getpid());
+    else
+        snprintf(tmp, len + 32, "%s.tmp", path);
+    char why[1024] = "";
+    int rc = 0;
+    if (fill(tmp, ctx, why, sizeof why) != 0) {
+        snprintf(err, errlen, "cannot write %s: %s", path, why[0] ? why : strerror(EIO));
+        rc = -1;
+    } else if (rename(tmp, path) != 0) {
+        snprintf(err, errlen, "cannot rename %s to %s: %s", tmp, path, strerror(errno));
+        rc = -1;
+    }
+    if (rc != 0)
+        remove(tmp);
+    free(tmp);
+    return rc;
+}
+
+typedef struct bytes {
+    const void *data;
+    size_t len;
+} bytes;
+
+/* The bytes as tmp, every write checked (fwrite, fflush, fclose). */
+static int fill_bytes(const char *tmp, void *ctx, char *why, size_t whylen)
+{
+    const bytes *b = ctx;
     errno = 0;
-    int failed = fflush(fp) != 0 || ferror(fp);
+    FILE *fp = fopen(tmp, "wb");
+    if (!fp) {
+        snprintf(why, whylen, "%s", strerror(errno));
+        return -1;
+    }
+    int failed = fwrite(b->data, 1, b->len, fp) != b->len || fflush(fp) != 0 || ferror(fp);
     int saved = errno;
     if (fclose(fp) != 0 && !failed) {
         failed = 1;
         saved = errno;
     }
-    if (failed) {
-        snprintf(err, errlen, "cannot write %s: %s", path,
-                 strerror(saved ? saved : EIO));
-        remove(tmp);
-        return -1;
-    }
-    if (rename(tmp, path) != 0) {
-        snprintf(err, errlen, "cannot rename %s to %s: %s", tmp, path, strerror(errno));
-        remove(tmp);
-        return -1;
-    }
-    return 0;
+    if (failed)
+        snprintf(why, whylen, "%s", strerror(saved ? saved : EIO));
+    return failed ? -1 : 0;
 }
 
 int cs_file_write_atomic(const char *path, const void *data, size_t len, char *err,
                          size_t errlen)
 {
-    char *tmp = cs_path_tmp(path);
-    if (!tmp) {
-        snprintf(err, errlen, "cannot write %s: out of memory", path);
-        return -1;
-    }
-    int rc = -1;
-    errno = 0;
-    FILE *fp = fopen(tmp, "wb");
-    if (!fp) {
-        snprintf(err, errlen, "cannot write %s: %s", path, strerror(errno));
-    } else if (fwrite(data, 1, len, fp) != len) {
-        snprintf(err, errlen, "cannot write %s: %s", path, strerror(errno ? errno : EIO));
-        fclose(fp);
-        remove(tmp);
-    } else {
-        rc = cs_file_commit(fp, tmp, path, err, errlen);
-    }
-    free(tmp);
-    return rc;
+    bytes b = {data, len};
+    return cs_write_atomic(path, false, fill_bytes, &b, err, errlen);
 }
 
 char *cs_file_read_all(const char *path, size_t *len)

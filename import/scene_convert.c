@@ -1,0 +1,462 @@
+/* scene_convert.c: the raw structs libcyaml filled -> a cs_scene.
+ *
+ * Every value is checked here once, against the range its key has in
+ * scene_keys.def, and an absent one gets the default from there; keys the
+ * table converts TO a field go through cs_sl_convert_keys, the others
+ * through the code of their section (cloths: scene_cloth.c; meshes and mesh
+ * bodies: scene_mesh.c).
+ */
+#include "import/scene_internal.h"
+
+#include <assert.h>
+#include <ctype.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+/* ------------------------------------------------------- value checks */
+
+static void key_path(const char *base, const cs_scene_key *k, int index, char *buf, size_t len)
+{
+    int w = snprintf(buf, len, "%s%s%s", base, *base ? "." : "", k->key);
+    if (index >= 0 && w > 0 && (size_t)w < len)
+        snprintf(buf + w, len - (size_t)w, "[%d]", index);
+}
+
+static int fail_range(loader *L, const char *path, const cs_key_range *r)
+{
+    char text[64];
+    cs_key_range_text(r, text, sizeof text);
+    return cs_sl_fail(L, path, true, "must be %s", text);
+}
+
+static double key_default(const cs_scene_key *k, int i)
+{
+    return k->def ? k->def(i) : 0.0;
+}
+
+int cs_sl_num(loader *L, const cs_scene_key *k, const double *v, const char *base, double *out)
+{
+    char p[PATH_LEN];
+    if (v && !cs_key_in_range(&k->range, *v)) {
+        key_path(base, k, -1, p, sizeof p);
+        return fail_range(L, p, &k->range);
+    }
+    *out = v ? *v : key_default(k, 0);
+    return CS_IMPORT_OK;
+}
+
+int cs_sl_int(loader *L, const cs_scene_key *k, const int *v, const char *base, int index, int *out)
+{
+    char p[PATH_LEN];
+    const cs_key_range *r = &k->range;
+    if (v && r->lo_kind == CS_BOUND_GE && *v < r->lo) {
+        key_path(base, k, index, p, sizeof p);
+        return cs_sl_fail(L, p, true, "must be >= %d", (int)r->lo);
+    }
+    if (v && r->hi_kind == CS_BOUND_GE && *v > r->hi) {
+        key_path(base, k, index, p, sizeof p);
+        return cs_sl_fail(L, p, true, "must be at most %d", (int)r->hi);
+    }
+    *out = v ? *v : (int)key_default(k, index < 0 ? 0 : index);
+    return CS_IMPORT_OK;
+}
+
+int cs_sl_vec(loader *L, const cs_scene_key *k, const double *v, const char *base,
+              const double *def, double *out)
+{
+    char p[PATH_LEN];
+    for (int i = 0; i < k->n; i++) {
+        if (v && !cs_key_in_range(&k->range, v[i])) {
+            key_path(base, k, i, p, sizeof p);
+            return fail_range(L, p, &k->range);
+        }
+        out[i] = v ? v[i] : def ? def[i] : key_default(k, i);
+    }
+    return CS_IMPORT_OK;
+}
+
+int cs_sl_convert_keys(loader *L, int section, const void *raw, const char *base, void *target)
+{
+    int rc = CS_IMPORT_OK;
+    for (int i = 0; i < CS_KEY_COUNT && !rc; i++) {
+        const cs_scene_key *k = &cs_scene_keys[i];
+        if (k->section != section || k->target < 0)
+            continue;
+        const void *v = raw ? *(const void *const *)((const char *)raw + k->raw) : NULL;
+        char *t = (char *)target + k->target;
+        switch (k->type) {
+        case CS_KT_NUM: rc = cs_sl_num(L, k, v, base, (double *)t); break;
+        case CS_KT_INT: rc = cs_sl_int(L, k, v, base, -1, (int *)t); break;
+        case CS_KT_VEC: rc = cs_sl_vec(L, k, v, base, NULL, (double *)t); break;
+        case CS_KT_BOOL: *(bool *)t = v ? *(const bool *)v : key_default(k, 0) != 0; break;
+        case CS_KT_ENUM: /* into an enum type: an int to the compilers we build with */
+            *(int *)t = v ? *(const int *)v : (int)key_default(k, 0);
+            break;
+        default: assert(!"a TO key of a type cs_sl_convert_keys does not convert");
+        }
+    }
+    return rc;
+}
+
+int cs_sl_check_name(loader *L, const char *name, const char *path)
+{
+    if (name && !*name)
+        return cs_sl_fail(L, path, false, "must not be empty");
+    return CS_IMPORT_OK;
+}
+
+int cs_sl_entry_name(loader *L, const char *given, const char *list, const char *stem, int index,
+                     const char *(*before)(const cs_scene *, int), const cs_scene *s, char **out)
+{
+    char base[48], p[PATH_LEN], fallback[48];
+    int err;
+    snprintf(base, sizeof base, "%s[%d]", list, index);
+    snprintf(p, sizeof p, "%s.name", base);
+    if ((err = cs_sl_check_name(L, given, p)))
+        return err;
+    snprintf(fallback, sizeof fallback, "%s%d", stem, index);
+    if (!(*out = cs_sl_strdup(given ? given : fallback)))
+        return CS_IMPORT_NOMEM;
+    for (int j = 0; j < index; j++)
+        if (!strcmp(before(s, j), *out))
+            return cs_sl_fail(L, given ? p : base, false,
+                              "must differ from the name of %s[%d] (got %s)", list, j, *out);
+    return CS_IMPORT_OK;
+}
+
+char *cs_sl_strdup(const char *s)
+{
+    size_t n = strlen(s) + 1;
+    char *d = malloc(n);
+    if (d)
+        memcpy(d, s, n);
+    return d;
+}
+
+bool cs_sl_note(cs_scene *s, const char *fmt, ...)
+{
+    char line[1024];
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(line, sizeof line, fmt, ap);
+    va_end(ap);
+    char **notes = realloc(s->notes, ((size_t)s->nnotes + 1) * sizeof *notes);
+    if (!notes)
+        return false;
+    s->notes = notes;
+    if (!(notes[s->nnotes] = cs_sl_strdup(line)))
+        return false;
+    s->nnotes++;
+    return true;
+}
+
+char *cs_sl_scene_dir(const char *file)
+{
+    const char *slash = file ? strrchr(file, '/') : NULL;
+    if (!file || file[0] == '<' || !slash)
+        return cs_sl_strdup(".");
+    size_t n = slash == file ? 1 : (size_t)(slash - file);
+    char *d = malloc(n + 1);
+    if (d) {
+        memcpy(d, file, n);
+        d[n] = '\0';
+    }
+    return d;
+}
+
+const char *cs_sl_base_name(const char *path)
+{
+    const char *slash = strrchr(path, '/');
+    return slash ? slash + 1 : path;
+}
+
+/* --------------------------------------------------------------- bodies */
+
+/* A key that the body's shape does not use is a mistake, not a no-op. */
+static int unused(loader *L, const void *given, const char *base, const char *key, int shape)
+{
+    char p[PATH_LEN];
+    if (!given)
+        return CS_IMPORT_OK;
+    snprintf(p, sizeof p, "%s.%s", base, key);
+    return cs_sl_fail(L, p, false, "is not used by a %s (remove it)",
+                      cs_scene_enum_name(CS_SKEY(body, shape), shape));
+}
+
+static int required(loader *L, const void *given, const char *base, const char *key, int shape)
+{
+    char p[PATH_LEN];
+    if (given)
+        return CS_IMPORT_OK;
+    snprintf(p, sizeof p, "%s.%s", base, key);
+    return cs_sl_fail(L, p, false, "is required for a %s",
+                      cs_scene_enum_name(CS_SKEY(body, shape), shape));
+}
+
+static const char *body_name(const cs_scene *s, int j)
+{
+    return s->def.bodies[j].name;
+}
+
+static int convert_body(loader *L, const cs_raw_body *rb, int bi, cs_scene *s)
+{
+    cs_body_def *bd = (cs_body_def *)&s->def.bodies[bi];
+    char base[48], p[PATH_LEN];
+    double pos[3], q[4];
+    int err, shape = rb->shape;
+
+    *bd = cs_default_body_def();
+    bd->name = NULL;
+    memset(&bd->motion, 0, sizeof bd->motion);
+    snprintf(base, sizeof base, "bodies[%d]", bi);
+    char *name = NULL;
+    err = cs_sl_entry_name(L, rb->name, "bodies", "body", bi, body_name, s, &name);
+    bd->name = name;
+    if (err)
+        return err;
+    bd->shape = (cs_body_shape)shape;
+
+    if ((err = cs_sl_vec(L, CS_SKEY(body, position), rb->position, base, NULL, pos)))
+        return err;
+    if (rb->normal) {
+        double n[3], len;
+        if ((err = unused(L, shape == CS_BODY_PLANE ? NULL : rb->normal, base, "normal", shape)))
+            return err;
+        snprintf(p, sizeof p, "%s.normal", base);
+        if (rb->rotation)
+            return cs_sl_fail(L, p, false, "expected either normal or rotation (got both)");
+        len = sqrt(rb->normal[0] * rb->normal[0] + rb->normal[1] * rb->normal[1] +
+                   rb->normal[2] * rb->normal[2]);
+        if (!(len > 0) || !isfinite(len))
+            return cs_sl_fail(L, p, false, "must be a nonzero vector");
+        for (int k = 0; k < 3; k++)
+            n[k] = rb->normal[k] / len;
+        cs_quat_from_y_to(n, q);
+    } else {
+        double deg[3];
+        if ((err = cs_sl_vec(L, CS_SKEY(body, rotation), rb->rotation, base, NULL, deg)))
+            return err;
+        cs_quat_from_euler_degrees(deg, q);
+    }
+
+    bool radius = shape == CS_BODY_SPHERE || shape == CS_BODY_CYLINDER;
+    bool size = shape == CS_BODY_BOX, height = shape == CS_BODY_CYLINDER;
+    if ((err = (radius ? required : unused)(L, rb->radius, base, "radius", shape)) ||
+        (err = (size ? required : unused)(L, rb->size, base, "size", shape)) ||
+        (err = (height ? required : unused)(L, rb->height, base, "height", shape)))
+        return err;
+    bool mesh = shape == CS_BODY_MESH;
+    if ((err = (mesh ? required : unused)(L, rb->mesh, base, "mesh", shape)) ||
+        (err = unused(L, mesh ? NULL : rb->voxel_size, base, "voxel_size", shape)) ||
+        (err = unused(L, mesh ? NULL : rb->band, base, "band", shape)) ||
+        (err = unused(L, mesh ? NULL : rb->close_holes, base, "close_holes", shape)) ||
+        (err = unused(L, mesh ? NULL : rb->interior, base, "interior", shape)))
+        return err;
+    if (mesh && (err = cs_sl_convert_mesh_body(L, rb, bi, s)))
+        return err;
+    if ((err = cs_sl_convert_keys(L, CS_SEC_body, rb, base, bd)))
+        return err;
+    if (rb->size) {
+        if ((err = cs_sl_vec(L, CS_SKEY(body, size), rb->size, base, NULL, bd->half_extents)))
+            return err;
+        for (int k = 0; k < 3; k++)
+            bd->half_extents[k] *= 0.5;
+    }
+    if (rb->height) {
+        if ((err = cs_sl_num(L, CS_SKEY(body, height), rb->height, base, &bd->half_height)))
+            return err;
+        bd->half_height *= 0.5;
+    }
+    if ((err = cs_sl_vec(L, CS_SKEY(body, color), rb->color, base, NULL, s->body_colors + 3 * bi)))
+        return err;
+    snprintf(p, sizeof p, "%s.motion", base);
+    return cs_sl_convert_motion(L, rb->motion, p, pos, q, &bd->motion);
+}
+
+/* ---------------------------------------------------------------- scene */
+
+static int convert_time(loader *L, const cs_raw_time *t, cs_scene *s)
+{
+    int rc = cs_sl_convert_keys(L, CS_SEC_time, t, "time", s);
+    if (rc || !t || !t->dt)
+        return rc;
+    /* A string in the schema so that "auto" loads; read the number here. */
+    char *end;
+    double dt = 0;
+    if (strcmp(t->dt, "auto") != 0) {
+        dt = strtod(t->dt, &end);
+        if (!*t->dt || isspace((unsigned char)*t->dt) || *end || !isfinite(dt) ||
+            !cs_key_in_range(&CS_SKEY(time, dt)->range, dt))
+            return cs_sl_fail(L, "time.dt", true, "expected a number >= 0 or auto");
+    }
+    s->def.dt = dt;
+    return CS_IMPORT_OK;
+}
+
+static int convert_camera(loader *L, const cs_raw_camera *c, cs_camera_def *cam)
+{
+    memset(cam, 0, sizeof *cam);
+    int rc = cs_sl_convert_keys(L, CS_SEC_camera, c, "camera", cam);
+    cam->given = c != NULL;
+    if (rc || !c)
+        return rc;
+    double dir[3], cross[3];
+    for (int k = 0; k < 3; k++)
+        dir[k] = cam->target[k] - cam->position[k];
+    if (dir[0] == 0 && dir[1] == 0 && dir[2] == 0)
+        return cs_sl_fail(L, "camera.target", false, "must differ from camera.position");
+    cross[0] = cam->up[1] * dir[2] - cam->up[2] * dir[1];
+    cross[1] = cam->up[2] * dir[0] - cam->up[0] * dir[2];
+    cross[2] = cam->up[0] * dir[1] - cam->up[1] * dir[0];
+    double lc = sqrt(cross[0] * cross[0] + cross[1] * cross[1] + cross[2] * cross[2]);
+    double lu = sqrt(cam->up[0] * cam->up[0] + cam->up[1] * cam->up[1] + cam->up[2] * cam->up[2]);
+    double ld = sqrt(dir[0] * dir[0] + dir[1] * dir[1] + dir[2] * dir[2]);
+    if (!(lc > 1e-9 * lu * ld))
+        return cs_sl_fail(L, "camera.up", false,
+                          "must be nonzero and not along the view direction (target - position)");
+    return CS_IMPORT_OK;
+}
+
+/* "dir/name.yaml" -> "name". */
+static char *file_stem(const char *file)
+{
+    const char *base = strrchr(file, '/');
+    base = base ? base + 1 : file;
+    const char *dot = strrchr(base, '.');
+    size_t n = dot && dot != base ? (size_t)(dot - base) : strlen(base);
+    char *stem = malloc(n + 1);
+    if (stem) {
+        memcpy(stem, base, n);
+        stem[n] = '\0';
+    }
+    return stem;
+}
+
+int cs_sl_convert_scene(loader *L, const cs_raw_scene *r, const char *default_name, cs_scene **out)
+{
+    int rc;
+    cs_scene *s = calloc(1, sizeof *s);
+    *out = NULL;
+    if (!s)
+        return CS_IMPORT_NOMEM;
+    s->def = cs_default_sim_def();
+    s->def.cloths = NULL;
+    s->def.ncloths = 0;
+    s->def.bodies = NULL;
+    s->def.nbodies = 0;
+
+    if ((rc = cs_sl_check_name(L, r->name, "name")))
+        goto fail;
+    s->name = r->name        ? cs_sl_strdup(r->name)
+              : default_name ? cs_sl_strdup(default_name)
+                             : file_stem(L->file);
+    s->path = cs_sl_strdup(L->file);
+    if (!s->name || !s->path)
+        goto nomem;
+
+    if ((rc = convert_time(L, r->time, s)) ||
+        (rc = cs_sl_vec(L, CS_SKEY(scene, gravity), r->gravity, "", NULL, s->def.gravity)) ||
+        (rc = cs_sl_convert_keys(L, CS_SEC_effects, r->effects, "effects", &s->def)))
+        goto fail;
+    bool wind_effect =
+        r->effects && r->effects->wind ? *r->effects->wind : CS_SKEY(effects, wind)->def(0) != 0;
+    L->self_collision = s->def.self_collision;
+    if ((rc = cs_sl_convert_keys(L, CS_SEC_self, r->self_collision, "self_collision",
+                                 &s->def.self)) ||
+        (rc = cs_sl_convert_keys(L, CS_SEC_wind, r->wind, "wind", &s->def.wind)))
+        goto fail;
+    s->def.wind_enabled = r->wind && wind_effect && s->def.wind.drag > 0;
+
+    const cs_scene_key *format = CS_SKEY(output, format);
+    s->output_format = cs_sl_strdup(cs_scene_enum_name(
+        format, r->output && r->output->format ? *r->output->format : (int)format->def(0)));
+    if (!s->output_format)
+        goto nomem;
+    if ((rc = convert_camera(L, r->camera, &s->camera)))
+        goto fail;
+
+    /* Arrays are zeroed first so that a partly filled scene frees cleanly. */
+    s->cloth_colors = calloc(3 * (size_t)r->cloths_count, sizeof *s->cloth_colors);
+    s->def.cloths = calloc(r->cloths_count, sizeof *s->def.cloths);
+    if (!s->cloth_colors || !s->def.cloths)
+        goto nomem;
+    s->def.ncloths = (int)r->cloths_count;
+    for (unsigned c = 0; c < r->cloths_count; c++)
+        if ((rc = cs_sl_convert_cloth(L, &r->cloths[c], (int)c, s)))
+            goto fail;
+
+    if (r->bodies_count > 0) {
+        s->body_colors = calloc(3 * (size_t)r->bodies_count, sizeof *s->body_colors);
+        s->def.bodies = calloc(r->bodies_count, sizeof *s->def.bodies);
+        s->mesh_bodies = calloc(r->bodies_count, sizeof *s->mesh_bodies);
+        if (!s->body_colors || !s->def.bodies || !s->mesh_bodies)
+            goto nomem;
+        s->def.nbodies = (int)r->bodies_count;
+        for (unsigned b = 0; b < r->bodies_count; b++)
+            if ((rc = convert_body(L, &r->bodies[b], (int)b, s)))
+                goto fail;
+        if ((rc = cs_sl_finish_mesh_bodies(L, s)))
+            goto fail;
+    }
+    if (r->levelset && r->levelset->cache && !*r->levelset->cache) {
+        rc = cs_sl_fail(L, "levelset.cache", false, "must not be empty (none turns the cache off)");
+        goto fail;
+    }
+    char *dir = cs_sl_scene_dir(L->file);
+    if (!dir)
+        goto nomem;
+    s->levelset_cache = cs_levelset_cache_dir(r->levelset ? r->levelset->cache : NULL, dir);
+    free(dir);
+    *out = s;
+    return CS_IMPORT_OK;
+nomem:
+    rc = CS_IMPORT_NOMEM;
+fail:
+    cs_scene_destroy(s);
+    return rc;
+}
+
+void cs_scene_destroy(cs_scene *s)
+{
+    if (!s)
+        return;
+    for (int c = 0; s->def.cloths && c < s->def.ncloths; c++) {
+        cs_cloth_def *cd = (cs_cloth_def *)&s->def.cloths[c];
+        free((void *)cd->name);
+        if (cd->mesh)
+            cs_trimesh_destroy((cs_trimesh *)cd->mesh);
+        for (int i = 0; cd->scripts && i < cd->nscripts; i++) {
+            free((void *)cd->scripts[i].vertices);
+            free((void *)cd->scripts[i].motion.keys);
+        }
+        free((void *)cd->scripts);
+    }
+    free((void *)s->def.cloths);
+    for (int b = 0; s->def.bodies && b < s->def.nbodies; b++) {
+        free((void *)s->def.bodies[b].name);
+        free((void *)s->def.bodies[b].motion.keys);
+    }
+    free((void *)s->def.bodies);
+    for (int b = 0; s->mesh_bodies && b < s->def.nbodies; b++) {
+        cs_scene_mesh_body *mb = &s->mesh_bodies[b];
+        if (mb->sign_mesh != mb->mesh)
+            cs_trimesh_destroy(mb->sign_mesh);
+        cs_trimesh_destroy(mb->mesh);
+        cs_levelset_destroy(mb->levelset);
+        free(mb->file);
+        free(mb->cache_path);
+    }
+    free(s->mesh_bodies);
+    free(s->levelset_cache);
+    for (int i = 0; i < s->nnotes; i++)
+        free(s->notes[i]);
+    free(s->notes);
+    free(s->name);
+    free(s->path);
+    free(s->output_format);
+    free(s->cloth_colors);
+    free(s->body_colors);
+    free(s);
+}
