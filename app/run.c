@@ -364,8 +364,12 @@ static void print_plan(const cs_scene *scene, const cs_sim *sim, FILE *out)
     double dt = cs_sim_dt(sim);
     fprintf(out, "step size %.6g s (stability limit %.6g s): %d steps per frame at %g fps\n",
             dt, cs_sim_stable_dt(sim), steps_per_frame(scene->def.fps, dt), scene->def.fps);
-    fprintf(out, "  (2/omega_max, omega_max^2 by Lanczos iterations; Gershgorin's bound would "
-            "give %.6g s)\n", cs_sim_gershgorin_dt(sim));
+    fprintf(out, "  (limits at rest: undamped 2/omega_max %.6g s by Lanczos iterations, %.6g s "
+            "by Gershgorin's bound; the damped scheme's %.6g s)\n", cs_sim_undamped_dt(sim),
+            cs_sim_gershgorin_dt(sim), cs_sim_damped_dt(sim));
+    if (!(scene->def.dt > 0) && scene->def.step_limit == CS_STEP_DAMPED)
+        fprintf(out, "  time.step_limit damped: the step is chosen again before every outer "
+                "step, smaller where the cloth is stretched\n");
     fprintf(out, "%d frames after the initial one: %.6g s of simulated time; %d particles\n",
             scene->frames, scene->def.fps > 0 ? scene->frames / scene->def.fps : 0.0,
             cs_sim_particle_count(sim));
@@ -632,13 +636,13 @@ int cs_run_main(int argc, char **argv)
         status = rc == CS_ERR_NOMEM ? CS_EXIT_OUTPUT : CS_EXIT_INPUT;
         goto done;
     }
-    if (root && scene->def.dt > cs_sim_stable_dt(r.sim)) /* allowed: damping may hold it */
+    if (root && scene->def.dt > cs_sim_damped_dt(r.sim)) /* allowed: a sufficient bound */
         fprintf(stderr,
                 "clothsim: warning: %s: time.dt %.3g s is %.3g times the stability limit "
-                "%.3g s of the undamped elastic forces; damping may keep it stable, and a "
+                "%.3g s of the cloth at rest (damping included); it may still run, and a "
                 "run that blows up stops with exit status 3\n",
-                scene->path, scene->def.dt, scene->def.dt / cs_sim_stable_dt(r.sim),
-                cs_sim_stable_dt(r.sim));
+                scene->path, scene->def.dt, scene->def.dt / cs_sim_damped_dt(r.sim),
+                cs_sim_damped_dt(r.sim));
     if (o.plan_only) {
         if (root)
             print_plan(scene, r.sim, stdout);

@@ -36,6 +36,10 @@ static const cyaml_strval_t friction_names[] = {
     {"improved", CS_FRICTION_IMPROVED},
     {"projection", CS_FRICTION_PROJECTION},
 };
+static const cyaml_strval_t step_limit_names[] = {
+    {"undamped", CS_STEP_UNDAMPED},
+    {"damped", CS_STEP_DAMPED},
+};
 static const cyaml_strval_t scheme_names[] = {
     {"fixed", CS_COLLISION_FIXED},
     {"rewind", CS_COLLISION_REWIND},

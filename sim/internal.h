@@ -78,7 +78,10 @@ struct cs_sim {
     double *wind_area;            /* 1 per particle */
 
     double t, dt, h;              /* h: half step of the current solve */
-    double stable_dt;             /* the damped scheme's limit at rest (step_limit.c) */
+    double frame_end;             /* advance_frame's end time: a step that
+                                   * lands within round-off of it lands on it */
+    double stable_dt;             /* the limit def.step_limit names, at rest */
+    double damped_dt;             /* the damped scheme's limit at rest (step_limit.c) */
     double undamped_dt;           /* 2 / omega_max, omega_max^2 by Lanczos */
     double gershgorin_dt;         /* the same from Gershgorin's bound (smaller) */
     cs_par *par;                  /* ownership, ghosts, messages (Section 7) */
@@ -119,7 +122,8 @@ void cs_runaway_check(cs_sim *sim, const double *v, cs_stage stage);
 bool cs_runaway_end_step(cs_sim *sim);
 
 /* step_limit.c: the stability limits at the rest state (stable_dt,
- * undamped_dt, gershgorin_dt), and the limit at the current positions
+ * damped_dt, undamped_dt, gershgorin_dt), and the damped limit at the
+ * current positions
  * (collective: every rank calls it at the same point). */
 void cs_step_limit_init(cs_sim *sim);
 double cs_step_limit_now(cs_sim *sim);

@@ -96,6 +96,8 @@ static int validate(const cs_sim_def *def, char *err, size_t errlen)
         return fail(err, errlen, "fps must be > 0");
     if (!(def->dt >= 0) || !(def->dt_safety > 0 && def->dt_safety <= 1))
         return fail(err, errlen, "dt must be >= 0 and dt_safety in (0, 1]");
+    if (def->step_limit != CS_STEP_UNDAMPED && def->step_limit != CS_STEP_DAMPED)
+        return fail(err, errlen, "step_limit must be undamped or damped");
     if (def->collision_steps < 1 || !(def->cg_tolerance > 0) || def->cg_max_iterations < 1)
         return fail(err, errlen, "collision_steps, cg_tolerance and cg_max_iterations must be positive");
     if (!finite3(def->gravity))
@@ -327,9 +329,10 @@ int cs_sim_create_checked(const cs_sim_def *def, cs_sim **out, char *err, size_t
         }
     }
 
-    /* time step: the damped scheme's limit at the rest state (step_limit.c),
+    /* time step: the stability limits at the rest state (step_limit.c),
      * from all springs on every rank (before the partition keeps its own);
-     * advance_frame refreshes it from the tension before each outer step */
+     * with the damped limit, advance_frame chooses the step again from the
+     * tension before each outer step */
     cs_step_limit_init(sim);
     double frame = 1.0 / def->fps;
     double dt_max = def->dt > 0 ? def->dt : def->dt_safety * sim->stable_dt;
@@ -531,6 +534,8 @@ int cs_sim_step(cs_sim *sim, double dt)
     const cs_plan *plan = &sim->plan;
     bool bodies = cs_plan_has(plan, CS_STAGE_BODY_COLLISION);
     double t1 = sim->t + dt;
+    if (fabs(t1 - sim->frame_end) <= 1e-9 * dt)
+        t1 = sim->frame_end;
     sim->h = 0.5 * dt;
     /* x (owned and ghosts) is current here; v only where owned */
     copy_ranges(par->local, par->nlocal, sim->x_prev, sim->x);
@@ -708,12 +713,17 @@ static int outer_step(cs_sim *sim, int k)
     }
 }
 
+static bool adaptive_step(const cs_sim *sim)
+{
+    return !(sim->def.dt > 0) && sim->def.step_limit == CS_STEP_DAMPED;
+}
+
 /* The step for the rest of a frame: the frame's remaining time in equal
  * steps no longer than dt_safety times the stability limit at the current
  * positions (or the scene's fixed step). Returns the number of steps. */
 static long steps_for(cs_sim *sim, double remaining)
 {
-    if (sim->def.dt > 0) /* fixed: the step set at creation */
+    if (!adaptive_step(sim)) /* fixed: the step set at creation */
         return lround(remaining / sim->dt);
     double dt_max = sim->def.dt_safety * cs_step_limit_now(sim);
     double steps = ceil(remaining / fmin(dt_max, remaining) - 1e-9);
@@ -729,6 +739,7 @@ int cs_sim_advance_frame(cs_sim *sim, cs_frame_stats *stats)
 {
     double frame = 1.0 / sim->def.fps;
     double t_end = sim->t + frame;
+    sim->frame_end = t_end;
     long steps = 0;
     long cg0 = sim->cg_iterations, contacts0 = sim->contacts;
     cs_selfcol_stats self0 = {0};
@@ -741,7 +752,9 @@ int cs_sim_advance_frame(cs_sim *sim, cs_frame_stats *stats)
      * straddle a frame end, so every frame ends collision-free. The step is
      * chosen afresh before each chunk, from the tension the cloth has then
      * (step_limit.c); the steps left divide the frame's remaining time. */
-    bool adaptive = !(sim->def.dt > 0);
+    bool adaptive = adaptive_step(sim);
+    /* the last step lands on t_end (cs_sim_step), free of the steps'
+     * round-off */
     long left = steps_for(sim, frame);
     while (left > 0 && status == CS_OK) {
         long chunk = left < sim->def.collision_steps ? left : sim->def.collision_steps;
@@ -751,8 +764,6 @@ int cs_sim_advance_frame(cs_sim *sim, cs_frame_stats *stats)
         if (left > 0 && adaptive && status == CS_OK)
             left = steps_for(sim, t_end - sim->t);
     }
-    if (status == CS_OK && adaptive)
-        sim->t = t_end; /* the frame's time, free of the steps' round-off */
     /* rank 0 gets the whole state: frames are written once */
     cs_par_begin(sim->par, CS_STAGE_POSITION_UPDATE);
     cs_par_gather_root(sim->par, sim->x, 3);
@@ -823,6 +834,7 @@ double cs_sim_time(const cs_sim *sim) { return sim->t; }
 double cs_sim_dt(const cs_sim *sim) { return sim->dt; }
 double cs_sim_stable_dt(const cs_sim *sim) { return sim->stable_dt; }
 double cs_sim_undamped_dt(const cs_sim *sim) { return sim->undamped_dt; }
+double cs_sim_damped_dt(const cs_sim *sim) { return sim->damped_dt; }
 double cs_sim_gershgorin_dt(const cs_sim *sim) { return sim->gershgorin_dt; }
 int cs_sim_particle_count(const cs_sim *sim) { return sim->n; }
 int cs_sim_spring_count(const cs_sim *sim) { return sim->nsprings; }

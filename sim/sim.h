@@ -193,6 +193,14 @@ typedef struct cs_cloth_def {
 
 /* --------------------------------------------------------------- the run */
 
+/* How the automatic step is bounded. */
+typedef enum cs_step_limit {
+    CS_STEP_UNDAMPED = 0, /* dt_safety x 2 / omega_max: the elastic forces alone, fixed */
+    CS_STEP_DAMPED,       /* dt_safety x the damped scheme's limit at the current
+                           * tension, chosen before every outer step (step_limit.c):
+                           * larger steps, less accurate contact and friction */
+} cs_step_limit;
+
 typedef enum cs_friction_method {
     CS_FRICTION_IMPROVED = 0,  /* Section 6: crossing point, Gamma, v_NP */
     CS_FRICTION_PROJECTION,    /* Bridson et al. 2003: project along normal */
@@ -233,6 +241,7 @@ typedef struct cs_sim_def {
     double fps;                /* frames per second of output */
     double dt;                 /* > 0: fixed step; 0: automatic from stability */
     double dt_safety;          /* fraction of the stability limit used (auto) */
+    cs_step_limit step_limit;  /* which limit (auto) */
     int collision_steps;       /* k_i: time steps per outer collision loop */
     double cg_tolerance;       /* m/s, max norm of the velocity residual */
     int cg_max_iterations;
@@ -388,11 +397,12 @@ long cs_sim_count_intersections(const cs_sim *sim);
 
 double cs_sim_time(const cs_sim *sim);
 double cs_sim_dt(const cs_sim *sim);          /* step used by advance_frame */
-/* Stability limits at the rest state: the damped scheme's (the largest of
- * its Gershgorin test and the undamped limit; the automatic step is
- * dt_safety times it, refreshed from the cloth's tension before each outer
- * step), and the undamped 2 / omega_max by Lanczos and by Gershgorin. */
+/* Stability limits at the rest state: the one the automatic step uses
+ * (def.step_limit), the damped scheme's (the larger of its Gershgorin test
+ * and the undamped limit), and the undamped 2 / omega_max by Lanczos and by
+ * Gershgorin. */
 double cs_sim_stable_dt(const cs_sim *sim);
+double cs_sim_damped_dt(const cs_sim *sim);
 double cs_sim_undamped_dt(const cs_sim *sim);
 double cs_sim_gershgorin_dt(const cs_sim *sim);
 int cs_sim_particle_count(const cs_sim *sim);
