@@ -16,6 +16,7 @@ static const struct {
     [CS_STAGE_SELF_FRICTION] = {"self_friction", "B.8 inelastic self-repulsion and friction"},
     [CS_STAGE_COLLISIONS] = {"collisions", "C: continuous collisions and impact zones (Section 4)"},
     [CS_STAGE_VERIFY] = {"verify", "count intersecting triangle pairs (independent check)"},
+    [CS_STAGE_FRAME_END] = {"frame_end", "the frame to rank 0, counters summed over ranks"},
 };
 
 const char *cs_stage_name(cs_stage stage)
@@ -52,6 +53,7 @@ cs_plan cs_plan_from_def(const cs_sim_def *def)
         [CS_STAGE_BODY_COLLISION] = def->bodies_enabled && def->nbodies > 0,
         [CS_STAGE_VELOCITY_FULL] = true,
         [CS_STAGE_BODY_FRICTION] = def->bodies_enabled && def->nbodies > 0,
+        [CS_STAGE_FRAME_END] = true,
     };
     cs_plan plan = {0};
     for (int s = 0; s < CS_STAGE_COUNT; s++)

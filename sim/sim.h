@@ -286,6 +286,7 @@ typedef enum cs_stage {
     CS_STAGE_SELF_FRICTION,         /* B.8 inelastic repulsion and friction */
     CS_STAGE_COLLISIONS,            /* C: continuous collisions, impact zones */
     CS_STAGE_VERIFY,                /* intersecting triangle pairs at frame end */
+    CS_STAGE_FRAME_END,             /* gathering the frame, summing counters over ranks */
     CS_STAGE_COUNT
 } cs_stage;
 

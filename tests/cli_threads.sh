@@ -58,6 +58,23 @@ s = json.load(open(sys.argv[1]))
 assert sum(f["body_contacts"] for f in s["frames"]) > 0 and sum(f["cg_iterations"] for f in s["frames"]) > 0
 PY
 
+# the damped step limit: the step is chosen before every outer step from
+# maxima over particles, so threads see the same steps and the same bits;
+# the steps change with the tension (fewer in free fall than in contact)
+for t in 1 2; do
+    run 0 run "$SCENES/drape.yaml" -o damped$t --frames 9 --threads $t \
+        --set 'cloths.0.grid.resolution=[36,36]' --set time.step_limit=damped -q
+done
+same_frames damped1 damped2
+python3 - damped1/summary.json drape1/summary.json <<'PY' || fail "the damped step did not adapt"
+import json, sys
+d, u = (json.load(open(p))["frames"] for p in sys.argv[1:3])
+steps = [f["steps"] for f in d]
+assert min(steps) < max(steps), steps  # free fall against contact
+assert sum(steps) < sum(f["steps"] for f in u), (steps, [f["steps"] for f in u])
+assert all(f.get("intersections", 0) == 0 for f in d)
+PY
+
 # a mesh body (an OpenVDB level set queried by both threads at once)
 for t in 1 2; do
     run 0 run "$SCENES/bunny_drape.yaml" -o bunny$t --frames 8 --threads $t -q
@@ -76,6 +93,21 @@ err_has "--threads"
 
 # hybrid: two ranks of one thread against one rank of two threads
 SMALL="--set cloths.0.grid.resolution=[16,16] --frames 3 -q"
+# (the damped step is chosen from maxima over ranks: the same steps too)
+DAMPED="--set time.step_limit=damped --set cloths.0.grid.resolution=[24,24] --frames 8 -q"
+# shellcheck disable=SC2086
+run 0 run "$SCENES/drape.yaml" -o damped_one2 --threads 2 $DAMPED
+status=0
+# shellcheck disable=SC2086
+"$MPIEXEC" --oversubscribe -np 2 "$EXE" run "$SCENES/drape.yaml" -o damped_two1 --threads 1 $DAMPED \
+    >out.txt 2>err.txt || status=$?
+[ "$status" -eq 0 ] || fail "mpirun -np 2 clothsim run --threads 1 (damped) exited $status"
+python3 - damped_one2/summary.json damped_two1/summary.json <<'PY' || fail "damped steps differ across ranks"
+import json, sys
+a, b = (json.load(open(p))["frames"] for p in sys.argv[1:3])
+assert [f["steps"] for f in a] == [f["steps"] for f in b], (a, b)
+assert len(set(f["steps"] for f in a)) > 1, [f["steps"] for f in a]
+PY
 # shellcheck disable=SC2086
 run 0 run "$SCENES/drape.yaml" -o one2 --threads 2 $SMALL
 status=0

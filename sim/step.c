@@ -1,0 +1,452 @@
+/* step.c: the time step of Section 3 as a table of stages, the outer
+ * collision loop of Section 4 around it, and a frame of outer steps. */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "common/util.h"
+#include "sim/internal.h"
+#include "sim/vec3.h"
+
+/* Each stage's time and calls, in one place. */
+#define STAGE_BEGIN(sim, stage)                                        \
+    double stage_t0_##stage = cs_now();                                \
+    cs_par_begin((sim)->par, stage)
+#define STAGE_END(sim, stage)                                          \
+    do {                                                               \
+        (sim)->timing[stage].seconds += cs_now() - stage_t0_##stage;   \
+        (sim)->timing[stage].calls++;                                  \
+    } while (0)
+
+/* Targets of scripted vertices at time t: position and velocity. */
+static void script_targets(cs_sim *sim, double t)
+{
+    for (int s = 0; s < sim->nscripts; s++) {
+        cs_script_state *sc = sim->scripts + s;
+        double R[9], c[3], vel[3], w[3];
+        cs_motion_pose(&sc->motion, t, R, c, vel, w);
+        for (int j = 0; j < sc->nvertices; j++) {
+            int g = sc->vertices[j];
+            double r[3], wr[3];
+            cs_mat_apply(R, sc->local + 3 * j, r);
+            cs_cross(w, r, wr);
+            for (int d = 0; d < 3; d++) {
+                sim->script_x[3 * g + d] = c[d] + r[d];
+                sim->script_v[3 * g + d] = vel[d] + wr[d];
+            }
+        }
+    }
+}
+
+/* Area-weighted vertex normals and a third of the adjacent area. */
+static void wind_geometry(cs_sim *sim, const double *x)
+{
+    memset(sim->wind_normal, 0, sizeof(double) * 3 * (size_t)sim->n);
+    memset(sim->wind_area, 0, sizeof(double) * (size_t)sim->n);
+    for (int c = 0; c < sim->ncloths; c++) {
+        const cs_trimesh *m = sim->cloths[c].mesh;
+        int off = sim->cloths[c].offset;
+        for (int t = 0; t < m->nt; t++) {
+            int a = off + m->tri[3 * t], b = off + m->tri[3 * t + 1], cc = off + m->tri[3 * t + 2];
+            double e1[3], e2[3], cr[3];
+            cs_sub(x + 3 * b, x + 3 * a, e1);
+            cs_sub(x + 3 * cc, x + 3 * a, e2);
+            cs_cross(e1, e2, cr); /* |cr| = twice the area */
+            int v[3] = {a, b, cc};
+            for (int k = 0; k < 3; k++) {
+                cs_axpy(1.0, cr, sim->wind_normal + 3 * v[k]);
+                sim->wind_area[v[k]] += cs_norm(cr) / 6.0;
+            }
+        }
+    }
+    for (int i = 0; i < sim->n; i++) {
+        double *nrm = sim->wind_normal + 3 * i, l = cs_norm(nrm);
+        if (l > 0)
+            for (int d = 0; d < 3; d++)
+                nrm[d] /= l;
+    }
+}
+
+/* force = elastic(x) + m g + explicit wind part, for owned particles (the
+ * springs also add into ghosts, which nobody reads) */
+static void explicit_forces(cs_sim *sim, const double *x)
+{
+    CS_FOR_LOCAL(sim->par, i)
+        sim->force[3 * i] = sim->force[3 * i + 1] = sim->force[3 * i + 2] = 0;
+    cs_springs_add_elastic(&sim->springs, x, sim->force);
+    CS_FOR_OWNED(sim->par, i)
+        cs_axpy(sim->mass[i], sim->def.gravity, sim->force + 3 * i);
+    if (sim->wind_normal) {
+        double c = sim->def.wind.drag;
+        CS_FOR_OWNED(sim->par, i) {
+            const double *nrm = sim->wind_normal + 3 * i;
+            cs_axpy(c * sim->wind_area[i] * cs_dot(nrm, sim->def.wind.velocity), nrm,
+                    sim->force + 3 * i);
+        }
+    }
+}
+
+/* rhs = M v_start + h force */
+static void momentum_rhs(cs_sim *sim, const double *v_start)
+{
+    CS_FOR_OWNED(sim->par, i)
+        for (int d = 0; d < 3; d++)
+            sim->rhs[3 * i + d] = sim->mass[i] * v_start[3 * i + d] + sim->h * sim->force[3 * i + d];
+}
+
+/* Copies 3 doubles per particle over the given ranges. */
+static void copy_ranges(const int *ranges, int nranges, double *dst, const double *src)
+{
+    for (int r = 0; r < nranges; r++)
+        memcpy(dst + 3 * ranges[2 * r], src + 3 * ranges[2 * r],
+               sizeof(double) * 3 * (size_t)(ranges[2 * r + 1] - ranges[2 * r]));
+}
+
+/* The improved method applies B.5's forces without the contact
+ * projection, so that B.7 sees the normal force. Where that force pulls a
+ * contact particle off the body, nothing in B.5 damped the pull (the
+ * projection held the normal velocity), and at steps far above the
+ * undamped limit the explicit pull grows without bound. Such a particle
+ * leaves the body: it takes the projected solve's velocity, as the
+ * previous method would give it, and B.4 stops holding it next step. */
+static void release_separating(cs_sim *sim, int i, double t1, const double *v_p)
+{
+    int b = sim->contact_body[i];
+    if (b < 0)
+        return;
+    double vb[3], rel[3];
+    cs_body_def_velocity(sim->bodies + b, t1, sim->x + 3 * i, vb);
+    cs_sub(sim->v_next + 3 * i, vb, rel);
+    if (cs_dot(rel, sim->contact_normal + 3 * i) <= 0)
+        return;
+    for (int d = 0; d < 3; d++)
+        sim->v_next[3 * i + d] = 2.0 * v_p[3 * i + d] - sim->v_star[3 * i + d];
+}
+
+/* ------------------------------------------------------------ the step
+ *
+ * The stages of one time step (Section 3's B.1-B.8, with the scripted
+ * vertices and wind before them), in order. The plan (plan.c) says which
+ * the scene needs; cs_sim_step runs those, times each in one place and
+ * checks the velocity each one makes for a runaway. Adding a stage is a
+ * row here and one in plan.c. */
+typedef struct step_state {
+    double dt, t1;
+    bool bodies; /* the plan has B.4 and B.7 */
+} step_state;
+
+typedef const double *(*stage_fn)(cs_sim *sim, const step_state *st);
+
+static const double *stage_scripted_vertices(cs_sim *sim, const step_state *st)
+{
+    script_targets(sim, st->t1);
+    return NULL;
+}
+
+static const double *stage_wind(cs_sim *sim, const step_state *st)
+{
+    (void)st;
+    wind_geometry(sim, sim->x);
+    return NULL;
+}
+
+/* B.1: v~^(n+1/2) = v^n + dt/2 a(x^n, v~^(n+1/2)), unconstrained by
+ * contact (constraining it would make cloth stick to bodies). Scripted
+ * particles move straight to their targets. */
+static const double *stage_velocity_half(cs_sim *sim, const step_state *st)
+{
+    cs_par *par = sim->par;
+    copy_ranges(par->own, par->nown, sim->v0, sim->v);
+    CS_FOR_OWNED(par, i)
+        if (!sim->is_free[i])
+            for (int d = 0; d < 3; d++)
+                sim->v0[3 * i + d] = (sim->script_x[3 * i + d] - sim->x[3 * i + d]) / st->dt;
+    explicit_forces(sim, sim->x); /* prepares the springs' directions at x^n too */
+    momentum_rhs(sim, sim->v);
+    sim->cg_iterations += cs_cg_solve(sim, sim->v0, sim->rhs, sim->v_half, sim->cg.warm_half);
+    return sim->v_half;
+}
+
+/* B.2: repulsions change only the velocity that moves the positions */
+static const double *stage_self_repulsion(cs_sim *sim, const step_state *st)
+{
+    cs_selfcol_repulse(sim, sim->x, sim->v_half, st->dt, true);
+    return sim->v_half;
+}
+
+/* B.3; without bodies, v*^n is v^n */
+static const double *stage_position_update(cs_sim *sim, const step_state *st)
+{
+    CS_FOR_OWNED(sim->par, i) {
+        if (sim->is_free[i]) {
+            for (int d = 0; d < 3; d++)
+                sim->x[3 * i + d] = sim->x_prev[3 * i + d] + st->dt * sim->v_half[3 * i + d];
+        } else { /* exact targets, free of round-off */
+            memcpy(sim->x + 3 * i, sim->script_x + 3 * i, 3 * sizeof(double));
+        }
+    }
+    if (!st->bodies)
+        copy_ranges(sim->par->own, sim->par->nown, sim->v_star, sim->v);
+    return NULL;
+}
+
+/* B.4 */
+static const double *stage_body_collision(cs_sim *sim, const step_state *st)
+{
+    cs_body_collide(sim, st->dt);
+    return sim->v_star;
+}
+
+/* B.5 and B.6: v^(n+1/2) = v*^n + dt/2 a(x^(n+1/2), v^(n+1/2)) with the
+ * normal velocity of contact particles held (P), then
+ * v^(n+1) = 2 v^(n+1/2) - v*^n. The improved method extrapolates from
+ * v_NP: the same forces, damping evaluated at the projected solution,
+ * applied without projection, so B.7 sees the normal force. The ghosts'
+ * new positions (B.3's and B.4's) arrive first. */
+static const double *stage_velocity_full(cs_sim *sim, const step_state *st)
+{
+    cs_par *par = sim->par;
+    cs_halo_forward(par, &par->ghosts, sim->x, 3);
+    CS_FOR_OWNED(par, i)
+        if (!sim->is_free[i])
+            memcpy(sim->v_star + 3 * i, sim->v0 + 3 * i, 3 * sizeof(double));
+    CS_FOR_LOCAL(par, i) /* x^(n+1/2), reusing v_half */
+        for (int d = 0; d < 3; d++)
+            sim->v_half[3 * i + d] = 0.5 * (sim->x_prev[3 * i + d] + sim->x[3 * i + d]);
+    explicit_forces(sim, sim->v_half); /* and at x^(n+1/2) */
+    momentum_rhs(sim, sim->v_star);
+    double *v_p = sim->v0; /* v0 is free again */
+    copy_ranges(par->own, par->nown, sim->cg.b, sim->v_star);
+    sim->cg_iterations += cs_cg_solve(sim, sim->cg.b, sim->rhs, v_p, sim->cg.warm_full);
+    if (st->bodies && sim->def.friction_method == CS_FRICTION_IMPROVED) {
+        copy_ranges(par->local, par->nlocal, sim->v_next, sim->force);
+        cs_halo_forward(par, &par->ghosts, v_p, 3);
+        cs_damping_apply(sim, v_p, sim->v_next); /* F_i + F_d v_P */
+        CS_FOR_OWNED(par, i) {
+            for (int d = 0; d < 3; d++) {
+                int k = 3 * i + d;
+                double v_np = sim->v_star[k] + sim->h / sim->mass[i] * sim->v_next[k];
+                sim->v_next[k] = 2.0 * v_np - sim->v_star[k];
+            }
+            release_separating(sim, i, st->t1, v_p);
+        }
+    } else {
+        CS_FOR_OWNED(par, i)
+            for (int d = 0; d < 3; d++)
+                sim->v_next[3 * i + d] = 2.0 * v_p[3 * i + d] - sim->v_star[3 * i + d];
+    }
+    CS_FOR_OWNED(par, i)
+        if (!sim->is_free[i])
+            memcpy(sim->v_next + 3 * i, sim->script_v + 3 * i, 3 * sizeof(double));
+    return sim->v_next;
+}
+
+/* B.7 */
+static const double *stage_body_friction(cs_sim *sim, const step_state *st)
+{
+    cs_body_friction(sim, st->dt);
+    return sim->v_next;
+}
+
+/* B.8: inelastic repulsion and friction on the final velocity */
+static const double *stage_self_friction(cs_sim *sim, const step_state *st)
+{
+    cs_selfcol_repulse(sim, sim->x, sim->v_next, st->dt, false);
+    return sim->v_next;
+}
+
+static const struct {
+    cs_stage stage;
+    stage_fn run; /* returns the velocity it made, for the runaway check */
+} STEP_STAGES[] = {
+    {CS_STAGE_SCRIPTED_VERTICES, stage_scripted_vertices},
+    {CS_STAGE_WIND, stage_wind},
+    {CS_STAGE_VELOCITY_HALF, stage_velocity_half},
+    {CS_STAGE_SELF_REPULSION, stage_self_repulsion},
+    {CS_STAGE_POSITION_UPDATE, stage_position_update},
+    {CS_STAGE_BODY_COLLISION, stage_body_collision},
+    {CS_STAGE_VELOCITY_FULL, stage_velocity_full},
+    {CS_STAGE_BODY_FRICTION, stage_body_friction},
+    {CS_STAGE_SELF_FRICTION, stage_self_friction},
+};
+
+/* True on every rank when every owned particle is finite everywhere. */
+int cs_sim_step(cs_sim *sim, double dt)
+{
+    cs_par *par = sim->par;
+    step_state st = {.dt = dt, .t1 = sim->t + dt,
+                     .bodies = cs_plan_has(&sim->plan, CS_STAGE_BODY_COLLISION)};
+    if (fabs(st.t1 - sim->frame_end) <= 1e-9 * dt)
+        st.t1 = sim->frame_end; /* the frame's last step lands on its end */
+    sim->h = 0.5 * dt;
+    /* x (owned and ghosts) is current here; v only where owned */
+    copy_ranges(par->local, par->nlocal, sim->x_prev, sim->x);
+    CS_FOR_OWNED(par, i)
+        sim->mode[i] = sim->is_free[i] ? CS_FREE : CS_FIXED;
+    cs_runaway_begin_step(sim, st.t1);
+    for (size_t k = 0; k < sizeof STEP_STAGES / sizeof STEP_STAGES[0]; k++) {
+        cs_stage stage = STEP_STAGES[k].stage;
+        if (!cs_plan_has(&sim->plan, stage))
+            continue;
+        STAGE_BEGIN(sim, stage);
+        const double *v = STEP_STAGES[k].run(sim, &st);
+        if (v)
+            cs_runaway_check(sim, v, stage);
+        STAGE_END(sim, stage);
+    }
+    copy_ranges(par->own, par->nown, sim->v, sim->v_next);
+    sim->t = st.t1;
+    return cs_runaway_end_step(sim) ? CS_OK : CS_ERR_UNSTABLE;
+}
+
+/* One outer collision step of k time steps (Section 4): step A, k steps of
+ * B, step C. The rewind scheme (Bridson et al. 2002) first runs the k steps
+ * and, if step C would find a collision, goes back and tries again with k
+ * halved, until k = 1. Returns CS_OK or CS_ERR_UNSTABLE. */
+static int outer_step(cs_sim *sim, int k)
+{
+    cs_selfcol *sc = sim->selfcol;
+    if (!sc) {
+        for (int i = 0; i < k; i++)
+            if (cs_sim_step(sim, sim->dt) != CS_OK)
+                return CS_ERR_UNSTABLE;
+        return CS_OK;
+    }
+    bool rewind = sim->def.self.scheme == CS_COLLISION_REWIND;
+    size_t bytes = sizeof(double) * 3 * (size_t)sim->n;
+    double t0 = sim->t;
+    if (rewind) /* keep the start to come back to; x equals x_free here */
+        memcpy(sim->v_rewind, sim->v, bytes);
+    for (;;) {
+        STAGE_BEGIN(sim, CS_STAGE_REPULSION_PAIRS);
+        cs_selfcol_find_pairs(sim, k * sim->dt);
+        STAGE_END(sim, CS_STAGE_REPULSION_PAIRS);
+        for (int i = 0; i < k; i++)
+            if (cs_sim_step(sim, sim->dt) != CS_OK)
+                return CS_ERR_UNSTABLE;
+        if (rewind && k > 1) {
+            STAGE_BEGIN(sim, CS_STAGE_COLLISIONS);
+            long found = cs_selfcol_collide(sim, sim->t - t0, k, true);
+            STAGE_END(sim, CS_STAGE_COLLISIONS);
+            if (found > 0) {
+                memcpy(sim->x, sc->x_free, bytes);
+                memcpy(sim->v, sim->v_rewind, bytes);
+                sim->t = t0;
+                sc->stats.rewinds++;
+                /* the halves run one after another, each from its own start */
+                int first = k / 2, status = outer_step(sim, first);
+                if (status != CS_OK)
+                    return status;
+                return outer_step(sim, k - first);
+            }
+        }
+        STAGE_BEGIN(sim, CS_STAGE_COLLISIONS);
+        cs_selfcol_collide(sim, sim->t - t0, k, false);
+        cs_runaway_check(sim, sim->v, CS_STAGE_COLLISIONS);
+        STAGE_END(sim, CS_STAGE_COLLISIONS);
+        return cs_runaway_end_step(sim) ? CS_OK : CS_ERR_UNSTABLE;
+    }
+}
+
+static bool adaptive_step(const cs_sim *sim)
+{
+    return !(sim->def.dt > 0) && sim->def.step_limit == CS_STEP_DAMPED;
+}
+
+/* The step for the rest of a frame: the frame's remaining time in equal
+ * steps no longer than dt_safety times the stability limit at the current
+ * positions (or the scene's fixed step). Returns the number of steps. */
+static long steps_for(cs_sim *sim, double remaining)
+{
+    if (!adaptive_step(sim)) /* fixed: the step set at creation */
+        return lround(remaining / sim->dt);
+    double dt_max = sim->def.dt_safety * cs_step_limit_now(sim);
+    double steps = ceil(remaining / fmin(dt_max, remaining) - 1e-9);
+    if (!(steps >= 1))
+        steps = 1;
+    if (steps > CS_MAX_STEPS_PER_FRAME)
+        steps = CS_MAX_STEPS_PER_FRAME;
+    sim->dt = remaining / steps;
+    return (long)steps;
+}
+
+int cs_sim_advance_frame(cs_sim *sim, cs_frame_stats *stats)
+{
+    double frame = 1.0 / sim->def.fps;
+    double t_end = sim->t + frame;
+    sim->frame_end = t_end;
+    long steps = 0;
+    long cg0 = sim->cg_iterations, contacts0 = sim->contacts;
+    cs_selfcol_stats self0 = {0};
+    if (sim->selfcol) {
+        sim->selfcol->stats.max_zone = 0; /* the largest zone of this frame */
+        self0 = sim->selfcol->stats;
+    }
+    int status = CS_OK;
+    /* The outer collision loop: k_i time steps, then step C. Chunks never
+     * straddle a frame end, so every frame ends collision-free. The step is
+     * chosen afresh before each chunk, from the tension the cloth has then
+     * (step_limit.c); the steps left divide the frame's remaining time. */
+    bool adaptive = adaptive_step(sim);
+    /* the last step lands on t_end (cs_sim_step), free of the steps'
+     * round-off */
+    long left = steps_for(sim, frame);
+    while (left > 0 && status == CS_OK) {
+        long chunk = left < sim->def.collision_steps ? left : sim->def.collision_steps;
+        status = outer_step(sim, (int)chunk);
+        steps += chunk;
+        left -= chunk;
+        if (left > 0 && adaptive && status == CS_OK)
+            left = steps_for(sim, t_end - sim->t);
+    }
+    /* frame end: rank 0 gets the whole state (frames are written once),
+     * the verifier counts, and the counters each rank kept for its own
+     * particles and pairs are summed */
+    {
+        STAGE_BEGIN(sim, CS_STAGE_FRAME_END);
+        cs_par_gather_root(sim->par, sim->x, 3);
+        cs_par_gather_root(sim->par, sim->v, 3);
+        STAGE_END(sim, CS_STAGE_FRAME_END);
+    }
+    long intersections = -1;
+    if (status == CS_OK && cs_plan_has(&sim->plan, CS_STAGE_VERIFY)) {
+        STAGE_BEGIN(sim, CS_STAGE_VERIFY);
+        if (sim->par->rank == 0)
+            intersections = cs_sim_count_intersections(sim);
+        STAGE_END(sim, CS_STAGE_VERIFY);
+    }
+    double frame_end_t0 = cs_now();
+    cs_par_begin(sim->par, CS_STAGE_FRAME_END);
+    cs_selfcol_stats self = {0};
+    if (sim->selfcol)
+        self = sim->selfcol->stats;
+    long sums[4] = {sim->contacts - contacts0, self.repulsion_pairs - self0.repulsion_pairs,
+                    self.repulsions - self0.repulsions, self.collisions - self0.collisions};
+    cs_par_sum_long(sim->par, sums, 4);
+    double max_speed = 0;
+    CS_FOR_OWNED(sim->par, i)
+        max_speed = fmax(max_speed, cs_norm(sim->v + 3 * i));
+    cs_par_max(sim->par, &max_speed, 1);
+    sim->timing[CS_STAGE_FRAME_END].seconds += cs_now() - frame_end_t0; /* its second part */
+    cs_par_report(sim->par, sim->timing, sim->timing_all, sim->comm_all, sim->rank_comm);
+    if (stats) {
+        memset(stats, 0, sizeof *stats);
+        stats->steps = (int)steps;
+        stats->dt = frame / (double)steps; /* the mean step */
+        stats->cg_iterations = sim->cg_iterations - cg0;
+        stats->body_contacts = sums[0];
+        stats->max_speed = max_speed;
+        if (sim->selfcol) { /* passes, zones and rewinds are the same on every rank */
+            stats->repulsion_pairs = sums[1];
+            stats->repulsions = sums[2];
+            stats->collisions = sums[3];
+            stats->collision_passes = self.passes - self0.passes;
+            stats->impact_zones = self.zones - self0.zones;
+            stats->max_zone_size = self.max_zone;
+            stats->rewinds = self.rewinds - self0.rewinds;
+        }
+        stats->intersections = intersections;
+    }
+    return status;
+}
