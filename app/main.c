@@ -9,6 +9,7 @@
 #include "app/mesh_cmds.h"
 #include "app/render_cmd.h"
 #include "app/run.h"
+#include "app/sweep_cmd.h"
 #include "sim/sim.h"
 
 #include <stdio.h>
@@ -25,6 +26,9 @@ static const cs_command COMMANDS[] = {
     {.name = "run", .synopsis = "run SCENE",
      .summary = "simulate a scene file and write a mesh file per frame", .main = cs_run_main,
      .help = cs_run_help, .parallel = 1}, /* the one command that can span ranks */
+    {.name = "sweep", .synopsis = "sweep SCENE",
+     .summary = "run a scene over settings; cost and error against a reference",
+     .main = cs_sweep_main, .help = cs_sweep_help},
     {.name = "render", .synopsis = "render TARGET",
      .summary = "render a run's frames (or a scene's start) to PNG images",
      .main = cs_render_main, .help = cs_render_help},
