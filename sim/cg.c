@@ -136,14 +136,13 @@ int cs_cg_solve(cs_sim *sim, double *v0, const double *rhs, double *v, double *w
         int i = own[r];
         double B[6] = {0, 0, 0, 0, 0, 0}; /* xx yy zz xy xz yz of D's block, negated */
         for (int e = s->row_start[r]; e < s->row_start[r + 1]; e++) {
-            const double *u = s->row_direction + 3 * e;
-            double c = s->row_damping[e];
-            B[0] += c * u[0] * u[0];
-            B[1] += c * u[1] * u[1];
-            B[2] += c * u[2] * u[2];
-            B[3] += c * u[0] * u[1];
-            B[4] += c * u[0] * u[2];
-            B[5] += c * u[1] * u[2];
+            const double *w = s->row_direction + 3 * e; /* sqrt(d) u_hat */
+            B[0] += w[0] * w[0];
+            B[1] += w[1] * w[1];
+            B[2] += w[2] * w[2];
+            B[3] += w[0] * w[1];
+            B[4] += w[0] * w[2];
+            B[5] += w[1] * w[2];
         }
         if (sim->wind_normal) {
             const double *nd = sim->wind_normal + 3 * i;

@@ -123,7 +123,7 @@ int cs_springs_add_mesh(cs_springs *s, int offset, int nv, int nt, const int *tr
 
 static void free_rows(cs_springs *s)
 {
-    void *rows[] = {s->row_start, s->row_other, s->row_damping, s->row_direction,
+    void *rows[] = {s->row_start, s->row_other, s->row_sqrt_damping, s->row_direction,
                     s->row_magnitude, s->row_stiffness, s->row_inv_rest_length};
     for (size_t k = 0; k < sizeof rows / sizeof *rows; k++)
         free(rows[k]);
@@ -133,7 +133,7 @@ int cs_springs_index(cs_springs *s, int nrows, const int *particles, int npartic
 {
     free_rows(s);
     s->nrows = nrows;
-    s->row_damping = malloc(sizeof(double) * (2 * (size_t)s->n + 1));
+    s->row_sqrt_damping = malloc(sizeof(double) * (2 * (size_t)s->n + 1));
     s->row_direction = malloc(sizeof(double) * 3 * (2 * (size_t)s->n + 1));
     s->row_magnitude = malloc(sizeof(double) * (2 * (size_t)s->n + 1));
     s->row_stiffness = malloc(sizeof(double) * (2 * (size_t)s->n + 1));
@@ -142,7 +142,7 @@ int cs_springs_index(cs_springs *s, int nrows, const int *particles, int npartic
     s->row_start = calloc((size_t)nrows + 1, sizeof *s->row_start);
     s->row_other = malloc(sizeof *s->row_other * (2 * (size_t)s->n + 1));
     int *row_of = malloc(sizeof *row_of * ((size_t)nparticles + 1));
-    if (!s->row_start || !s->row_other || !row_of || !s->row_damping ||
+    if (!s->row_start || !s->row_other || !row_of || !s->row_sqrt_damping ||
         !s->row_direction || !s->row_magnitude || !s->row_stiffness || !s->row_inv_rest_length) {
         free(row_of);
         return -1;
@@ -169,7 +169,7 @@ int cs_springs_index(cs_springs *s, int nrows, const int *particles, int npartic
             int r = row_of[s->ends[2 * k + e]];
             if (r < 0)
                 continue;
-            s->row_damping[fill[r]] = s->damping[k];
+            s->row_sqrt_damping[fill[r]] = sqrt(s->damping[k]);
             s->row_stiffness[fill[r]] = s->stiffness[k];
             s->row_inv_rest_length[fill[r]] = s->inv_rest_length[k];
             s->row_other[fill[r]++] = s->ends[2 * k + 1 - e];
@@ -211,8 +211,9 @@ void cs_springs_prepare(cs_springs *s, const double *x)
             double inv = l > 0 ? 1.0 / l : 0;
             s->row_magnitude[e] =
                 l > 0 ? s->row_stiffness[e] * (s->row_inv_rest_length[e] - inv) : 0;
+            double scale = inv * s->row_sqrt_damping[e];
             for (int d = 0; d < 3; d++)
-                u[d] *= inv;
+                u[d] *= scale;
         }
     }
 }
@@ -298,7 +299,8 @@ double cs_springs_step_bound(const cs_springs *s, const double *mass,
         double sum = 0;
         for (int e = s->row_start[r]; e < s->row_start[r + 1]; e++)
             sum += cs_spring_step_term(dt, s->row_stiffness[e] * s->row_inv_rest_length[e],
-                                       s->row_damping[e], s->row_magnitude[e]);
+                                       s->row_sqrt_damping[e] * s->row_sqrt_damping[e],
+                                       s->row_magnitude[e]);
         if (2.0 * sum / mass[i] > bound)
             bound = 2.0 * sum / mass[i];
     }
