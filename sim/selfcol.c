@@ -1,13 +1,13 @@
-/* selfcol.c: history-based repulsions (Section 5), continuous collisions
- * and impact zones (Section 4). */
+/* selfcol.c: history-based repulsions (Section 5): the pairs of step A
+ * with their history, their response in B.2 and B.8, and the pairs' ranks
+ * (Section 7). Step C is in selfcol_collide.c. */
 #include <float.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
 #include "sim/ccd.h"
-#include "sim/internal.h"
-#include "sim/selfcol.h"
+#include "sim/selfcol_private.h"
 #include "sim/vec3.h"
 
 /* ------------------------------------------------------------ topology */
@@ -31,7 +31,7 @@ static int pair_push(cs_pair_list *l, const int v[4], const double *s0)
     return 0;
 }
 
-static int zone_find(int *parent, int i)
+int sc_zone_find(int *parent, int i)
 {
     while (parent[i] != i) {
         parent[i] = parent[parent[i]];
@@ -40,14 +40,14 @@ static int zone_find(int *parent, int i)
     return i;
 }
 
-static void zone_union(int *parent, int a, int b)
+void sc_zone_union(int *parent, int a, int b)
 {
     if (parent[a] < 0)
         parent[a] = a;
     if (parent[b] < 0)
         parent[b] = b;
-    a = zone_find(parent, a);
-    b = zone_find(parent, b);
+    a = sc_zone_find(parent, a);
+    b = sc_zone_find(parent, b);
     if (a != b)
         parent[a < b ? b : a] = a < b ? a : b;
 }
@@ -227,7 +227,7 @@ static bool pair_frame(const cs_pair *p, bool is_edge, const double *x, double e
     return true;
 }
 
-static double pair_inverse_mass(const cs_selfcol *sc, const cs_pair *p, const double c[4])
+double sc_pair_inverse_mass(const cs_selfcol *sc, const cs_pair *p, const double c[4])
 {
     double s = 0;
     for (int k = 0; k < 4; k++)
@@ -235,8 +235,8 @@ static double pair_inverse_mass(const cs_selfcol *sc, const cs_pair *p, const do
     return s;
 }
 
-static double pair_normal_velocity(const cs_pair *p, const double c[4], const double *v,
-                                   const double n[3], double rel[3])
+double sc_pair_normal_velocity(const cs_pair *p, const double c[4], const double *v,
+                               const double n[3], double rel[3])
 {
     rel[0] = rel[1] = rel[2] = 0;
     for (int k = 0; k < 4; k++)
@@ -245,8 +245,8 @@ static double pair_normal_velocity(const cs_pair *p, const double c[4], const do
 }
 
 /* v_k += c_k J / m_k dir: an impulse J on the pair's relative motion */
-static void pair_impulse(const cs_selfcol *sc, const cs_pair *p, const double c[4], double J,
-                         const double dir[3], double *v)
+void sc_pair_impulse(const cs_selfcol *sc, const cs_pair *p, const double c[4], double J,
+                     const double dir[3], double *v)
 {
     for (int k = 0; k < 4; k++)
         cs_axpy(c[k] * J * sc->inv_mass[p->v[k]], dir, v + 3 * p->v[k]);
@@ -254,11 +254,6 @@ static void pair_impulse(const cs_selfcol *sc, const cs_pair *p, const double c[
 
 /* ------------------------------------------------- pair response, once */
 
-typedef struct response {
-    bool inelastic, elastic, friction;
-    double dt;          /* for Eq. 1 */
-    double h, k, mu, epsilon;
-} response;
 
 /* Applies one pair's response to velocities v at positions x; returns true
  * if it interacted. Inelastic: I = m v_N stops approach; elastic: Eq. 1
@@ -267,7 +262,7 @@ typedef struct response {
 /* Whether the boxes of a pair's two sides (vertices [0, split) and
  * [split, 4) at positions p[k]) are more than gap apart along an axis:
  * then the sides are farther apart than gap. */
-static bool sides_apart(const double *const p[4], int split, double gap)
+bool sc_sides_apart(const double *const p[4], int split, double gap)
 {
     for (int d = 0; d < 3; d++) {
         double lo_a = INFINITY, hi_a = -INFINITY, lo_b = INFINITY, hi_b = -INFINITY;
@@ -293,7 +288,7 @@ static bool pair_near(const cs_pair *p, bool is_edge, const double *x, double h)
 {
     const double *const pts[4] = {x + 3 * p->v[0], x + 3 * p->v[1], x + 3 * p->v[2],
                                   x + 3 * p->v[3]};
-    return !sides_apart(pts, is_edge ? 2 : 3, h);
+    return !sc_sides_apart(pts, is_edge ? 2 : 3, h);
 }
 
 /* Bridson's proximity condition for a repulsion: a point/triangle pair
@@ -327,8 +322,8 @@ static bool pair_interior(const cs_pair *p, bool is_edge, const double *x, const
     return w0 > -tol && w1 > -tol && w2 > -tol;
 }
 
-static bool pair_respond(const cs_selfcol *sc, const cs_pair *p, bool is_edge, const double *x,
-                         double *v, const response *r)
+bool sc_pair_respond(const cs_selfcol *sc, const cs_pair *p, bool is_edge, const double *x,
+                     double *v, const response *r)
 {
     if (!pair_near(p, is_edge, x, r->h))
         return false;
@@ -337,13 +332,13 @@ static bool pair_respond(const cs_selfcol *sc, const cs_pair *p, bool is_edge, c
         return false;
     if (!(dist < r->h) || !pair_interior(p, is_edge, x, c, r->h))
         return false;
-    double inv_m = pair_inverse_mass(sc, p, c);
+    double inv_m = sc_pair_inverse_mass(sc, p, c);
     if (!(inv_m > 0))
         return false;
     double rel[3];
-    double vn = pair_normal_velocity(p, c, v, n, rel), dvn = 0;
+    double vn = sc_pair_normal_velocity(p, c, v, n, rel), dvn = 0;
     if (r->inelastic && vn < 0) {
-        pair_impulse(sc, p, c, -vn / inv_m, n, v);
+        sc_pair_impulse(sc, p, c, -vn / inv_m, n, v);
         dvn = -vn;
         vn = 0;
     }
@@ -351,7 +346,7 @@ static bool pair_respond(const cs_selfcol *sc, const cs_pair *p, bool is_edge, c
         double d = r->h - sd;
         double J = fmin(r->dt * r->k * d, (0.1 * d / r->dt - vn) / inv_m);
         if (J > 0) {
-            pair_impulse(sc, p, c, J, n, v);
+            sc_pair_impulse(sc, p, c, J, n, v);
             dvn += J * inv_m;
         }
     }
@@ -363,7 +358,7 @@ static bool pair_respond(const cs_selfcol *sc, const cs_pair *p, bool is_edge, c
         if (speed > 0) {
             double drop = fmin(r->mu * dvn, speed);
             double dir[3] = {vt[0] / speed, vt[1] / speed, vt[2] / speed};
-            pair_impulse(sc, p, c, -drop / inv_m, dir, v);
+            sc_pair_impulse(sc, p, c, -drop / inv_m, dir, v);
         }
     }
     return true;
@@ -376,9 +371,9 @@ static long cs_pairs_apply(const cs_selfcol *sc, const cs_pair_list *pt, const c
 {
     long applied = 0;
     for (int i = 0; i < pt->n; i++)
-        applied += pair_respond(sc, pt->p + i, false, x, v, r);
+        applied += sc_pair_respond(sc, pt->p + i, false, x, v, r);
     for (int i = 0; i < ee->n; i++)
-        applied += pair_respond(sc, ee->p + i, true, x, v, r);
+        applied += sc_pair_respond(sc, ee->p + i, true, x, v, r);
     return applied;
 }
 
@@ -386,7 +381,7 @@ static long cs_pairs_apply(const cs_selfcol *sc, const cs_pair_list *pt, const c
  * the plane itself: the side its own cloth is on, judged by its neighbours
  * along edges. Zero when that says nothing either (a lone particle, or a
  * cloth lying in the plane). */
-static double ring_side(const cs_selfcol *sc, const double *x, int point, const double nrm[3])
+double sc_ring_side(const cs_selfcol *sc, const double *x, int point, const double nrm[3])
 {
     double side = 0;
     for (int k = sc->ring_start[point]; k < sc->ring_start[point + 1]; k++) {
@@ -413,7 +408,7 @@ static bool wing_pair(const cs_selfcol *sc, int point, const int *tri)
 
 /* ------------------------------------------------- Section 7: ranks */
 
-static int pair_rank(const cs_par *par, const int v[4])
+int sc_pair_rank(const cs_par *par, const int v[4])
 {
     int r = par->owner[v[0]];
     for (int k = 1; k < 4; k++)
@@ -470,7 +465,7 @@ typedef struct wire_pair {
  * keeps in bpt and bee, in one Gauss-Seidel order, the pairs of the
  * components it processes: those whose lowest finding rank it is. bhalo
  * links their particles to their owners. Returns 0 or -1 (no memory). */
-static int distribute_boundary(cs_sim *sim, cs_pair_list *pt, cs_pair_list *ee)
+int sc_distribute_boundary(cs_sim *sim, cs_pair_list *pt, cs_pair_list *ee)
 {
     cs_selfcol *sc = sim->selfcol;
     cs_par *par = sim->par;
@@ -519,15 +514,15 @@ static int distribute_boundary(cs_sim *sim, cs_pair_list *pt, cs_pair_list *ee)
         parent[i] = -1;
     for (int k = 0; k < nall; k++)
         for (int j = 1; j < 4; j++)
-            zone_union(parent, all[k].v[0], all[k].v[j]);
+            sc_zone_union(parent, all[k].v[0], all[k].v[j]);
     for (int k = 0; k < nall; k++)
-        root_rank[zone_find(parent, all[k].v[0])] = par->size;
+        root_rank[sc_zone_find(parent, all[k].v[0])] = par->size;
     int *user = malloc(sizeof *user * (4 * (size_t)nall + 1));
     int *particle = malloc(sizeof *particle * (4 * (size_t)nall + 1));
     if (!user || !particle)
         rc = -1;
     for (int k = 0; k < nall; k++) {
-        int root = zone_find(parent, all[k].v[0]);
+        int root = sc_zone_find(parent, all[k].v[0]);
         if (all[k].rank < root_rank[root])
             root_rank[root] = all[k].rank;
     }
@@ -535,7 +530,7 @@ static int distribute_boundary(cs_sim *sim, cs_pair_list *pt, cs_pair_list *ee)
         for (int k = 0; k < nall && !rc; k++) {
             if (all[k].is_edge != l)
                 continue;
-            int proc = root_rank[zone_find(parent, all[k].v[0])];
+            int proc = root_rank[sc_zone_find(parent, all[k].v[0])];
             for (int j = 0; j < 4; j++) {
                 user[4 * k + j] = proc;
                 particle[4 * k + j] = all[k].v[j];
@@ -577,9 +572,8 @@ static bool may_meet(const finder *f, const int v[4], int split, double dist)
     return dist < f->h + rel * f->span;
 }
 
-/* The makers below turn a candidate (a, b) of a traversal into a pair, or
- * say no; they only read shared state, so threads run them side by side. */
-typedef bool (*pair_maker)(const void *ctx, int a, int b, cs_pair *out);
+/* The makers below turn a candidate (a, b) of a traversal into a pair
+ * (pair_maker, selfcol_private.h). */
 
 static bool make_repulsion_point_triangle(const void *ctx, int point, int t, cs_pair *out)
 {
@@ -589,7 +583,7 @@ static bool make_repulsion_point_triangle(const void *ctx, int point, int t, cs_
     if (point == tri[0] || point == tri[1] || point == tri[2] || wing_pair(sc, point, tri))
         return false;
     int quad[4] = {tri[0], tri[1], tri[2], point};
-    if (pair_rank(f->sim->par, quad) != f->sim->par->rank)
+    if (sc_pair_rank(f->sim->par, quad) != f->sim->par->rank)
         return false; /* another rank's to find */
     if (sc->inv_mass[point] == 0 && sc->inv_mass[tri[0]] == 0 && sc->inv_mass[tri[1]] == 0 &&
         sc->inv_mass[tri[2]] == 0)
@@ -610,7 +604,7 @@ static bool make_repulsion_point_triangle(const void *ctx, int point, int t, cs_
         return false;
     double side = cs_dot(nrm, r);
     if (fabs(side) <= 1e-12 * cs_norm(nrm) * (cs_norm(r) + cs_norm(e1)))
-        side = ring_side(sc, x, point, nrm); /* in the plane: ambiguous */
+        side = sc_ring_side(sc, x, point, nrm); /* in the plane: ambiguous */
     if (side < 0) {
         v[1] = tri[2];
         v[2] = tri[1];
@@ -628,7 +622,7 @@ static bool make_repulsion_edge_edge(const void *ctx, int ea, int eb, cs_pair *o
     if (a[0] == b[0] || a[0] == b[1] || a[1] == b[0] || a[1] == b[1])
         return false;
     int quad[4] = {a[0], a[1], b[0], b[1]};
-    if (pair_rank(f->sim->par, quad) != f->sim->par->rank)
+    if (sc_pair_rank(f->sim->par, quad) != f->sim->par->rank)
         return false; /* another rank's to find */
     if (sc->inv_mass[a[0]] == 0 && sc->inv_mass[a[1]] == 0 && sc->inv_mass[b[0]] == 0 &&
         sc->inv_mass[b[1]] == 0)
@@ -660,8 +654,8 @@ static bool make_repulsion_edge_edge(const void *ctx, int ea, int eb, cs_pair *o
 /* Traverses A against B and appends the pairs make accepts to list, in the
  * traversal's order at any thread count: threads make pairs from the
  * candidates in place, then they are kept in order. Returns 0 or -1. */
-static int find_pairs(cs_selfcol *sc, const cs_bvh *A, const cs_bvh *B, bool only_dirty, int rank,
-                      pair_maker make, const void *ctx, cs_pair_list *list)
+int sc_find_pairs(cs_selfcol *sc, const cs_bvh *A, const cs_bvh *B, bool only_dirty, int rank,
+                  pair_maker make, const void *ctx, cs_pair_list *list)
 {
     if (cs_bvh_collect(A, B, only_dirty, rank, &sc->bvh_work, &sc->candidates))
         return -1;
@@ -737,12 +731,12 @@ void cs_selfcol_find_pairs(cs_sim *sim, double span)
     cs_bvh_refit(&sc->ttree, sc->tbox, NULL);
     finder f = {sim, sc, h, span};
     int rank = sim->par->rank;
-    int failed = find_pairs(sc, &sc->ptree, &sc->ttree, false, rank,
-                            make_repulsion_point_triangle, &f, &sc->pt) ||
-                 find_pairs(sc, &sc->etree, &sc->etree, false, rank, make_repulsion_edge_edge,
-                            &f, &sc->ee);
+    int failed = sc_find_pairs(sc, &sc->ptree, &sc->ttree, false, rank,
+                               make_repulsion_point_triangle, &f, &sc->pt) ||
+                 sc_find_pairs(sc, &sc->etree, &sc->etree, false, rank, make_repulsion_edge_edge,
+                               &f, &sc->ee);
     sc->stats.repulsion_pairs += sc->pt.n + sc->ee.n;
-    if (distribute_boundary(sim, &sc->pt, &sc->ee) != 0)
+    if (sc_distribute_boundary(sim, &sc->pt, &sc->ee) != 0)
         failed = 1;
     if (failed) /* out of memory: without pairs step C still keeps the cloth apart */
         sc->pt.n = sc->ee.n = sc->bpt.n = sc->bee.n = 0;
@@ -766,536 +760,4 @@ void cs_selfcol_repulse(cs_sim *sim, double *x, double *v, double dt, bool elast
         cs_halo_reverse(par, &sc->bhalo, v, 3);
     }
     sc->stats.repulsions += cs_pairs_apply(sc, &sc->pt, &sc->ee, x, v, &r);
-}
-
-/* ------------------------------------------------------------- step C */
-
-/* Positions of a pair's particles at time t of the trajectories. */
-static void pair_at(const cs_selfcol *sc, const cs_pair *p, const double *x, double t,
-                    double out[12])
-{
-    for (int k = 0; k < 4; k++)
-        for (int d = 0; d < 3; d++) {
-            double a = sc->x_free[3 * p->v[k] + d], b = x[3 * p->v[k] + d];
-            out[3 * k + d] = a + t * (b - a);
-        }
-}
-
-/* The conservative filter before any root finding. Along linear
- * trajectories the relative position of the pair at fixed weights moves by
- * a convex combination of the displacements of one side's vertices
- * relative to the other's, so the distance between the primitives never
- * drops faster than the largest such relative displacement ("reach"): a
- * pair farther apart at the start than the proximity tolerance plus its
- * reach cannot collide over the span. A sheet moving rigidly (reach 0) is
- * settled by one distance per pair instead of a vanishing cubic sampled 31
- * times. The slack covers the round-off of the distances compared. */
-static bool out_of_reach(const cs_selfcol *sc, bool is_edge, const double *x0, const double *dx)
-{
-    int split = is_edge ? 2 : 3; /* one side: vertices [0, split) */
-    double reach2 = 0, scale = 0;
-    for (int i = 0; i < split; i++)
-        for (int j = split; j < 4; j++) {
-            double r[3];
-            cs_sub(dx + 3 * j, dx + 3 * i, r);
-            double r2 = cs_dot(r, r);
-            reach2 = r2 > reach2 ? r2 : reach2;
-        }
-    for (int k = 0; k < 12; k++)
-        scale = fabs(x0[k]) + fabs(dx[k]) > scale ? fabs(x0[k]) + fabs(dx[k]) : scale;
-    double need = sc->proximity + sqrt(reach2);
-    need += 64 * DBL_EPSILON * (scale + need);
-    /* a separating axis of the start boxes bounds the distance first */
-    const double *const pts[4] = {x0, x0 + 3, x0 + 6, x0 + 9};
-    if (sides_apart(pts, split, need))
-        return true;
-    double d0, w[3], s, t;
-    if (is_edge)
-        d0 = cs_segment_segment_closest(x0, x0 + 3, x0 + 6, x0 + 9, &s, &t);
-    else
-        d0 = cs_point_triangle_closest(x0 + 9, x0, x0 + 3, x0 + 6, w);
-    return d0 > need;
-}
-
-/* Continuous test: the first coplanar time at which the pair comes within
- * the proximity tolerance; fills the weights c and a unit normal oriented
- * from the free state's side. */
-static bool pair_collides(const cs_selfcol *sc, const cs_pair *p, bool is_edge, const double *x,
-                          double c[4], double n[3])
-{
-    double x0[12], x1[12], dx[12], times[CS_CCD_MAX_TIMES];
-    pair_at(sc, p, x, 0, x0);
-    pair_at(sc, p, x, 1, x1);
-    for (int k = 0; k < 12; k++)
-        dx[k] = x1[k] - x0[k];
-    if (out_of_reach(sc, is_edge, x0, dx))
-        return false;
-    int nt = cs_coplanarity_times(x0, x0 + 3, x0 + 6, x0 + 9, dx, dx + 3, dx + 6, dx + 9, times);
-    for (int i = 0; i < nt; i++) {
-        double xt[12], dist, w[3], s, t;
-        for (int k = 0; k < 12; k++)
-            xt[k] = x0[k] + times[i] * dx[k];
-        if (!is_edge) {
-            dist = cs_point_triangle_closest(xt + 9, xt, xt + 3, xt + 6, w);
-            c[0] = -w[0], c[1] = -w[1], c[2] = -w[2], c[3] = 1;
-        } else {
-            dist = cs_segment_segment_closest(xt, xt + 3, xt + 6, xt + 9, &s, &t);
-            c[0] = -(1 - s), c[1] = -s, c[2] = 1 - t, c[3] = t;
-        }
-        if (!(dist < sc->proximity))
-            continue;
-        /* normal at the collision time: the triangle's, or the two edges'
-         * common perpendicular; falling back on the separation direction */
-        double e1[3], e2[3];
-        if (!is_edge) {
-            cs_sub(xt + 3, xt, e1);
-            cs_sub(xt + 6, xt, e2);
-        } else {
-            cs_sub(xt + 3, xt, e1);
-            cs_sub(xt + 9, xt + 6, e2);
-        }
-        cs_cross(e1, e2, n);
-        double len = cs_norm(n);
-        double rel0[3] = {0, 0, 0}, relv[3] = {0, 0, 0};
-        for (int k = 0; k < 4; k++) {
-            cs_axpy(c[k], x0 + 3 * k, rel0);
-            cs_axpy(c[k], dx + 3 * k, relv);
-        }
-        if (!(len > 1e-12 * (cs_dot(e1, e1) + cs_dot(e2, e2)))) {
-            memcpy(n, rel0, sizeof rel0);
-            len = cs_norm(n);
-            if (!(len > 0)) {
-                memcpy(n, relv, sizeof relv);
-                len = cs_norm(n);
-                if (!(len > 0))
-                    continue; /* nothing moves and nothing separates: no impulse helps */
-            }
-        }
-        for (int k = 0; k < 3; k++)
-            n[k] /= len;
-        /* orient from the side the pair started on; starting in contact, the
-         * side the point's cloth is on; failing that, against the approach */
-        double side = cs_dot(rel0, n);
-        if (!is_edge && fabs(side) <= 1e-12 * cs_norm(rel0))
-            side = ring_side(sc, sc->x_free, p->v[3], n);
-        if (side < 0 || (side == 0 && cs_dot(relv, n) > 0))
-            for (int k = 0; k < 3; k++)
-                n[k] = -n[k];
-        /* in contact at the start and moving apart: that is the response
-         * of an earlier pass working, not a collision */
-        if (times[i] == 0 && cs_dot(relv, n) >= 0)
-            continue;
-        return true;
-    }
-    return false;
-}
-
-/* A colliding pair's history, as step A gives its pairs: the side it
- * started on in the collision-free state (nrm, from pair_collides). An
- * edge/edge pair keeps it as s0; a point/triangle pair is wound so the
- * triangle's normal points at that side. Without it the elastic push of
- * the response reads no history (an edge pair) or pushes a point that came
- * from behind a triangle through it (a point pair). */
-static void set_history(const cs_selfcol *sc, cs_pair *p, bool is_edge, const double nrm[3])
-{
-    memcpy(p->s0, nrm, sizeof p->s0);
-    if (is_edge)
-        return;
-    const double *x = sc->x_free;
-    double e1[3], e2[3], wn[3];
-    cs_sub(x + 3 * p->v[1], x + 3 * p->v[0], e1);
-    cs_sub(x + 3 * p->v[2], x + 3 * p->v[0], e2);
-    cs_cross(e1, e2, wn);
-    if (cs_dot(wn, nrm) < 0) {
-        int swap = p->v[1];
-        p->v[1] = p->v[2];
-        p->v[2] = swap;
-    }
-}
-
-typedef struct collector {
-    const cs_selfcol *sc;
-    const cs_par *par;
-    const double *x;
-} collector;
-
-/* The pair (v) this rank finds, if it collides, with its history. */
-static bool collision_of(const collector *cl, const int v[4], bool is_edge, cs_pair *out)
-{
-    if (pair_rank(cl->par, v) != cl->par->rank)
-        return false;
-    memcpy(out->v, v, sizeof out->v);
-    double c[4], nrm[3];
-    if (!pair_collides(cl->sc, out, is_edge, cl->x, c, nrm))
-        return false;
-    set_history(cl->sc, out, is_edge, nrm);
-    return true;
-}
-
-static bool make_collision_point_triangle(const void *ctx, int point, int t, cs_pair *out)
-{
-    const collector *cl = ctx;
-    const int *tri = cl->sc->tri + 3 * t;
-    if (point == tri[0] || point == tri[1] || point == tri[2])
-        return false; /* wings stay: a wing point crossing drags its other triangles through */
-    int v[4] = {tri[0], tri[1], tri[2], point};
-    return collision_of(cl, v, false, out);
-}
-
-static bool make_collision_edge_edge(const void *ctx, int ea, int eb, cs_pair *out)
-{
-    const collector *cl = ctx;
-    const int *a = cl->sc->edge + 2 * ea, *b = cl->sc->edge + 2 * eb;
-    if (a[0] == b[0] || a[0] == b[1] || a[1] == b[0] || a[1] == b[1])
-        return false;
-    int v[4] = {a[0], a[1], b[0], b[1]};
-    return collision_of(cl, v, true, out);
-}
-
-/* Swept boxes from the free positions to x, and the pairs among their
- * primitives that collide along the trajectories, with their history (only
- * near changed particles when only_dirty). Returns how many, or -1 when
- * memory ran out. */
-static long find_collisions(cs_selfcol *sc, const cs_par *par, const double *x,
-                            bool only_dirty)
-{
-    double pad = sc->proximity;
-#pragma omp parallel for schedule(static)
-    for (int i = 0; i < sc->n; i++) {
-        cs_box *b = sc->pbox + i;
-        cs_box_empty(b);
-        cs_box_add_point(b, sc->x_free + 3 * i);
-        cs_box_add_point(b, x + 3 * i);
-        cs_box_thicken(b, pad);
-        sc->pdirty[i] = sc->vdirty[i];
-    }
-#pragma omp parallel for schedule(static)
-    for (int k = 0; k < sc->ne; k++) {
-        cs_box *b = sc->ebox + k;
-        int i = sc->edge[2 * k], j = sc->edge[2 * k + 1];
-        *b = sc->pbox[i];
-        cs_box_add_point(b, sc->pbox[j].lo);
-        cs_box_add_point(b, sc->pbox[j].hi);
-        sc->edirty[k] = sc->vdirty[i] | sc->vdirty[j];
-    }
-#pragma omp parallel for schedule(static)
-    for (int k = 0; k < sc->nt; k++) {
-        cs_box *b = sc->tbox + k;
-        const int *t = sc->tri + 3 * k;
-        *b = sc->pbox[t[0]];
-        cs_box_add_point(b, sc->pbox[t[1]].lo);
-        cs_box_add_point(b, sc->pbox[t[1]].hi);
-        cs_box_add_point(b, sc->pbox[t[2]].lo);
-        cs_box_add_point(b, sc->pbox[t[2]].hi);
-        sc->tdirty[k] = sc->vdirty[t[0]] | sc->vdirty[t[1]] | sc->vdirty[t[2]];
-    }
-    cs_bvh_refit(&sc->ptree, sc->pbox, sc->pdirty);
-    cs_bvh_refit(&sc->etree, sc->ebox, sc->edirty);
-    cs_bvh_refit(&sc->ttree, sc->tbox, sc->tdirty);
-    sc->cpt.n = sc->cee.n = 0;
-    collector cl = {sc, par, x};
-    if (find_pairs(sc, &sc->ptree, &sc->ttree, only_dirty, par->rank,
-                   make_collision_point_triangle, &cl, &sc->cpt) ||
-        find_pairs(sc, &sc->etree, &sc->etree, only_dirty, par->rank, make_collision_edge_edge,
-                   &cl, &sc->cee))
-        return -1;
-    return sc->cpt.n + sc->cee.n;
-}
-
-/* Symmetric 3x3 eigen decomposition by cyclic Jacobi rotations:
- * A = Q diag(l) Q^T, Q's columns the eigenvectors. */
-static void eigen_symmetric(const double A_in[9], double l[3], double Q[9])
-{
-    double A[9];
-    memcpy(A, A_in, sizeof A);
-    for (int k = 0; k < 9; k++)
-        Q[k] = (k % 4 == 0) ? 1 : 0;
-    for (int sweep = 0; sweep < 50; sweep++) {
-        double off = fabs(A[1]) + fabs(A[2]) + fabs(A[5]);
-        if (off <= 1e-300 || off < 1e-18 * (fabs(A[0]) + fabs(A[4]) + fabs(A[8])))
-            break;
-        for (int p = 0; p < 2; p++)
-            for (int q = p + 1; q < 3; q++) {
-                double apq = A[3 * p + q];
-                if (apq == 0)
-                    continue;
-                double theta = (A[3 * q + q] - A[3 * p + p]) / (2 * apq);
-                double t = copysign(1.0, theta) / (fabs(theta) + sqrt(theta * theta + 1));
-                double c = 1 / sqrt(t * t + 1), s = t * c;
-                for (int k = 0; k < 3; k++) { /* A = J^T A J */
-                    double akp = A[3 * k + p], akq = A[3 * k + q];
-                    A[3 * k + p] = c * akp - s * akq;
-                    A[3 * k + q] = s * akp + c * akq;
-                }
-                for (int k = 0; k < 3; k++) {
-                    double apk = A[3 * p + k], aqk = A[3 * q + k];
-                    A[3 * p + k] = c * apk - s * aqk;
-                    A[3 * q + k] = s * apk + c * aqk;
-                }
-                for (int k = 0; k < 3; k++) {
-                    double qkp = Q[3 * k + p], qkq = Q[3 * k + q];
-                    Q[3 * k + p] = c * qkp - s * qkq;
-                    Q[3 * k + q] = s * qkp + c * qkq;
-                }
-            }
-    }
-    l[0] = A[0], l[1] = A[4], l[2] = A[8];
-}
-
-void cs_impact_zone_motion(int n, const int *idx, const double *m, const double *xf,
-                           const double *u, double span, double *x, double vcm[3],
-                           double omega[3])
-{
-    double M = 0, xcm[3] = {0, 0, 0};
-    vcm[0] = vcm[1] = vcm[2] = 0;
-    for (int k = 0; k < n; k++) {
-        int i = idx[k];
-        M += m[i];
-        cs_axpy(m[i], xf + 3 * i, xcm);
-        cs_axpy(m[i], u + 3 * i, vcm);
-    }
-    for (int d = 0; d < 3; d++) {
-        xcm[d] /= M;
-        vcm[d] /= M;
-    }
-    double L[3] = {0, 0, 0}, I[9] = {0};
-    for (int k = 0; k < n; k++) {
-        int i = idx[k];
-        double r[3], du[3], rxu[3];
-        cs_sub(xf + 3 * i, xcm, r);
-        cs_sub(u + 3 * i, vcm, du);
-        cs_cross(r, du, rxu);
-        cs_axpy(m[i], rxu, L);
-        double rr = cs_dot(r, r);
-        for (int a = 0; a < 3; a++)
-            for (int b = 0; b < 3; b++)
-                I[3 * a + b] += m[i] * ((a == b ? rr : 0) - r[a] * r[b]);
-    }
-    /* omega = I^+ L: eigenvalues below round-off of the largest count as
-     * zero (coplanar, colinear, coincident points) */
-    double l[3], Q[9];
-    eigen_symmetric(I, l, Q);
-    double lmax = fmax(fabs(l[0]), fmax(fabs(l[1]), fabs(l[2])));
-    double qL[3];
-    cs_mat_apply_transpose(Q, L, qL);
-    for (int k = 0; k < 3; k++)
-        qL[k] = fabs(l[k]) > 1e-12 * lmax && l[k] != 0 ? qL[k] / l[k] : 0;
-    cs_mat_apply(Q, qL, omega);
-    double q[4], R[9];
-    cs_quat_from_rotation_vector(omega, span, q);
-    cs_quat_to_matrix(q, R);
-    for (int k = 0; k < n; k++) {
-        int i = idx[k];
-        double r[3], Rr[3];
-        cs_sub(xf + 3 * i, xcm, r);
-        cs_mat_apply(R, r, Rr);
-        for (int d = 0; d < 3; d++)
-            x[3 * i + d] = xcm[d] + span * vcm[d] + Rr[d];
-    }
-}
-
-/* Moves every impact zone rigidly; pinned and scripted particles weigh
- * far more than the rest and keep their prescribed positions. */
-static void rigidify_zones(cs_sim *sim, double span, double *dv)
-{
-    cs_selfcol *sc = sim->selfcol;
-    int n = sc->n;
-    /* scratch, free during step C: v_half, and CG's explicit start */
-    double *u = sim->v_half, *mw = sim->cg.explicit_z;
-    double heaviest = 0;
-    for (int i = 0; i < n; i++)
-        heaviest = fmax(heaviest, sim->mass[i]);
-    for (int i = 0; i < n; i++) {
-        for (int d = 0; d < 3; d++)
-            u[3 * i + d] = (sim->x[3 * i + d] - sc->x_free[3 * i + d]) / span;
-        mw[i] = sim->is_free[i] ? sim->mass[i] : 1e6 * heaviest;
-    }
-    for (int root = 0; root < n; root++) {
-        if (sc->zone[root] < 0 || zone_find(sc->zone, root) != root)
-            continue;
-        int count = 0;
-        for (int i = 0; i < n; i++)
-            if (sc->zone[i] >= 0 && zone_find(sc->zone, i) == root)
-                sc->zone_list[count++] = i;
-        double vcm[3], w[3];
-        cs_impact_zone_motion(count, sc->zone_list, mw, sc->x_free, u, span, sim->x, vcm, w);
-        for (int k = 0; k < count; k++) {
-            int i = sc->zone_list[k];
-            if (!sim->is_free[i])
-                memcpy(sim->x + 3 * i, sc->x_before + 3 * i, 3 * sizeof(double));
-            for (int d = 0; d < 3; d++) /* a zone is an inelastic merge: v follows */
-                dv[3 * i + d] += (sim->x[3 * i + d] - sc->x_free[3 * i + d]) / span - u[3 * i + d];
-            sc->vdirty[i] = 1;
-        }
-        if (count > sc->stats.max_zone)
-            sc->stats.max_zone = count;
-        for (int k = 1; k < count; k++)
-            if (sim->par->owner[sc->zone_list[k]] != sim->par->owner[sc->zone_list[0]]) {
-                sc->stats.zones_across++;
-                break;
-            }
-    }
-}
-
-/* One colliding pair's response in step C: inelastic on the effective
- * velocities u (the real velocity's change accumulates in dv), then an
- * elastic push if the end positions are too close. Returns false when the
- * pair no longer collides (an earlier response moved it). */
-static bool collision_respond(cs_selfcol *sc, const cs_pair *p, bool is_edge, double *x,
-                              double *u, double *dv, double span, const response *elastic)
-{
-    double c[4], nrm[3];
-    if (!pair_collides(sc, p, is_edge, x, c, nrm))
-        return false;
-    double inv_m = pair_inverse_mass(sc, p, c), rel[3];
-    if (!(inv_m > 0))
-        return true;
-    double un = pair_normal_velocity(p, c, u, nrm, rel);
-    if (un < 0) {
-        pair_impulse(sc, p, c, -un / inv_m, nrm, u);
-        pair_impulse(sc, p, c, -un / inv_m, nrm, dv);
-    }
-    for (int q = 0; q < 4; q++) {
-        int i = p->v[q];
-        for (int e = 0; e < 3; e++)
-            x[3 * i + e] = sc->x_free[3 * i + e] + span * u[3 * i + e];
-    }
-    if (pair_respond(sc, p, is_edge, x, u, elastic))
-        for (int q = 0; q < 4; q++) {
-            int i = p->v[q];
-            for (int e = 0; e < 3; e++)
-                x[3 * i + e] = sc->x_free[3 * i + e] + span * u[3 * i + e];
-        }
-    return true;
-}
-
-static void respond_all(cs_selfcol *sc, const cs_pair_list *pt, const cs_pair_list *ee,
-                        double *x, double *u, double *dv, double span, const response *elastic)
-{
-    for (int j = 0; j < pt->n; j++)
-        collision_respond(sc, pt->p + j, false, x, u, dv, span, elastic);
-    for (int j = 0; j < ee->n; j++)
-        collision_respond(sc, ee->p + j, true, x, u, dv, span, elastic);
-}
-
-/* Impact zones over all ranks: every rank merges every colliding pair's
- * particles in the same order, so all hold the same zones. Returns 0 or
- * -1. */
-static int merge_zones(cs_sim *sim)
-{
-    cs_selfcol *sc = sim->selfcol;
-    int nmine = sc->cpt.n + sc->cee.n;
-    int *mine = malloc(sizeof *mine * 4 * ((size_t)nmine + 1));
-    if (!mine)
-        return -1;
-    for (int l = 0, m = 0; l < 2; l++) {
-        const cs_pair_list *list = l == 0 ? &sc->cpt : &sc->cee;
-        for (int j = 0; j < list->n; j++, m++)
-            memcpy(mine + 4 * m, list->p[j].v, 4 * sizeof *mine);
-    }
-    void *gathered;
-    int nall;
-    int rc = cs_par_allgather_items(sim->par, mine, nmine, 4 * sizeof *mine, &gathered, &nall);
-    free(mine);
-    if (rc)
-        return -1;
-    const int *all = gathered;
-    for (int k = 0; k < nall; k++)
-        for (int q = 1; q < 4; q++)
-            zone_union(sc->zone, all[4 * k], all[4 * k + q]);
-    free(gathered);
-    return 0;
-}
-
-/* Step C on several ranks: each pass starts from positions synchronised to
- * every rank; each rank finds its assigned colliding pairs; responses run
- * in Fig. 12's two phases (components of boundary pairs, results sent to
- * the owners, then internal pairs); the pass count, the decision to stop
- * and the impact zones are global. On one rank there are no messages and
- * no boundary pairs. */
-long cs_selfcol_collide(cs_sim *sim, double span, int k, bool detect_only)
-{
-    cs_selfcol *sc = sim->selfcol;
-    cs_par *par = sim->par;
-    const cs_self_collision_def *d = &sim->def.self;
-    int n = sc->n;
-    double *x = sim->x;
-    size_t bytes = sizeof(double) * 3 * (size_t)n;
-    cs_par_allgather(par, x, 3);
-    memcpy(sc->x_before, x, bytes);
-    for (int i = 0; i < n; i++) {
-        sc->vdirty[i] = 1;
-        sc->zone[i] = -1;
-    }
-    /* elastic repulsion after a collision uses the average step of the
-     * loop, not the whole span: later steps' repulsions do the rest */
-    response elastic = {false, true, false, span / (k > 0 ? k : 1), d->thickness, d->stiffness,
-                        0, d->edge_flip_epsilon};
-    double *u = sim->v_next; /* effective velocities; scratch between steps */
-    /* The real velocity takes the inelastic changes only (impulses and
-     * zones); the elastic push moves positions, as in B.2 (Section 5). */
-    double *dv = sim->v0;
-    memset(dv, 0, bytes);
-    long first_pass = 0;
-    int zones_formed = 0;
-    for (int pass = 0;; pass++) {
-        if (pass > 0) { /* what moved since the last pass, on any rank */
-            cs_par_allgather(par, x, 3);
-            for (int i = 0; i < n; i++)
-                sc->vdirty[i] = memcmp(x + 3 * i, sc->x_pass + 3 * i, 3 * sizeof *x) != 0;
-        }
-        memcpy(sc->x_pass, x, bytes);
-        long found = find_collisions(sc, par, x, pass > 0), found_all = found;
-        if (found < 0)
-            abort(); /* out of memory finding collisions: no collision-free state to keep */
-        sc->stats.passes++;
-        bool zone_mode = pass >= d->zone_iterations;
-        for (int i = 0; i < n; i++)
-            for (int c = 0; c < 3; c++)
-                u[3 * i + c] = (x[3 * i + c] - sc->x_free[3 * i + c]) / span;
-        cs_par_sum_long(par, &found_all, 1);
-        if (pass == 0)
-            first_pass = found_all;
-        sc->stats.collisions += found;
-        if (detect_only || found_all == 0)
-            break;
-        if (zone_mode) {
-            if (merge_zones(sim) != 0)
-                abort(); /* out of memory in the last resort: nothing safe to do */
-            zones_formed++;
-            rigidify_zones(sim, span, dv);
-        } else {
-            if (distribute_boundary(sim, &sc->cpt, &sc->cee) != 0)
-                abort();
-            /* phase I: the state is synchronised; results go to the owners */
-            respond_all(sc, &sc->bpt, &sc->bee, x, u, dv, span, &elastic);
-            cs_halo_reverse(par, &sc->bhalo, x, 3);
-            cs_halo_reverse(par, &sc->bhalo, u, 3);
-            cs_halo_reverse(par, &sc->bhalo, dv, 3);
-            /* phase II */
-            respond_all(sc, &sc->cpt, &sc->cee, x, u, dv, span, &elastic);
-        }
-        if (pass > d->zone_iterations + 1000) {
-            /* cannot happen in exact arithmetic (zones only grow); stop
-             * the free particles at the collision-free state rather than
-             * loop forever */
-            for (int i = 0; i < n; i++)
-                if (sim->is_free[i])
-                    memcpy(x + 3 * i, sc->x_free + 3 * i, 3 * sizeof(double));
-            break;
-        }
-    }
-    if (detect_only)
-        return first_pass;
-    if (zones_formed) {
-        int roots = 0;
-        for (int i = 0; i < n; i++)
-            roots += sc->zone[i] >= 0 && zone_find(sc->zone, i) == i;
-        sc->stats.zones += roots;
-    }
-    CS_FOR_OWNED(par, i)
-        for (int c = 0; c < 3; c++)
-            sim->v[3 * i + c] += dv[3 * i + c];
-    memcpy(sc->x_free, x, bytes); /* the same on every rank */
-    return first_pass;
 }

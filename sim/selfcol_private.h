@@ -1,0 +1,36 @@
+/* selfcol_private.h: what step C (selfcol_collide.c) shares with the
+ * rest of the self-collision code (selfcol.c); private to those two. */
+#ifndef CS_SELFCOL_PRIVATE_H
+#define CS_SELFCOL_PRIVATE_H
+
+#include "sim/internal.h"
+#include "sim/selfcol.h"
+
+/* Turns a candidate (a, b) of a traversal into a pair, or says no; makers
+ * only read shared state, so threads run them side by side. */
+typedef bool (*pair_maker)(const void *ctx, int a, int b, cs_pair *out);
+
+/* How a pair responds (sc_pair_respond). */
+typedef struct response {
+    bool inelastic, elastic, friction;
+    double dt; /* for Eq. 1 */
+    double h, k, mu, epsilon;
+} response;
+
+int sc_distribute_boundary(cs_sim *sim, cs_pair_list *pt, cs_pair_list *ee);
+int sc_find_pairs(cs_selfcol *sc, const cs_bvh *A, const cs_bvh *B, bool only_dirty, int rank,
+                  pair_maker make, const void *ctx, cs_pair_list *list);
+void sc_pair_impulse(const cs_selfcol *sc, const cs_pair *p, const double c[4], double J,
+                     const double dir[3], double *v);
+double sc_pair_inverse_mass(const cs_selfcol *sc, const cs_pair *p, const double c[4]);
+double sc_pair_normal_velocity(const cs_pair *p, const double c[4], const double *v,
+                               const double n[3], double rel[3]);
+int sc_pair_rank(const cs_par *par, const int v[4]);
+bool sc_pair_respond(const cs_selfcol *sc, const cs_pair *p, bool is_edge, const double *x,
+                     double *v, const response *r);
+double sc_ring_side(const cs_selfcol *sc, const double *x, int point, const double nrm[3]);
+bool sc_sides_apart(const double *const p[4], int split, double gap);
+int sc_zone_find(int *parent, int i);
+void sc_zone_union(int *parent, int a, int b);
+
+#endif
