@@ -2,6 +2,7 @@
 #include "app/cli.h"
 
 #include <getopt.h>
+#include <stdio.h>
 #include <string.h>
 
 int cs_cli_error(const cs_cli *cli, const char *fmt, const char *arg)
@@ -25,4 +26,18 @@ int cs_cli_option_error(const cs_cli *cli, int c, char **argv)
     if (strncmp(arg, "--", 2) != 0 && optopt > ' ' && optopt < 127)
         arg = shortopt; /* e.g. the x of -qx */
     return cs_cli_error(cli, "unknown option '%s'", arg);
+}
+
+const char *cs_cli_operand(const cs_cli *cli, int argc, char **argv, int optind,
+                           const char *what, int *status)
+{
+    char msg[256];
+    if (optind >= argc)
+        snprintf(msg, sizeof msg, "no %s given", what);
+    else if (argc - optind > 1)
+        snprintf(msg, sizeof msg, "one %s only; '%s' is one too many", what, argv[optind + 1]);
+    else
+        return argv[optind];
+    *status = cs_cli_error(cli, "%s", msg);
+    return NULL;
 }

@@ -36,4 +36,10 @@ int cs_cli_error(const cs_cli *cli, const char *fmt, const char *arg);
  * unknown): says which option, as cs_cli_error. */
 int cs_cli_option_error(const cs_cli *cli, int c, char **argv);
 
+/* The command's one operand (a scene file, a run folder): argv[optind],
+ * or NULL after reporting "no WHAT given" or "one WHAT only; 'X' is one too
+ * many" (then *status is the exit status). */
+const char *cs_cli_operand(const cs_cli *cli, int argc, char **argv, int optind,
+                           const char *what, int *status);
+
 #endif

@@ -68,10 +68,10 @@ int cs_intersections_main(int argc, char **argv)
             return cs_cli_option_error(&CLI, c, argv);
         }
     }
-    if (argc - optind != 1)
-        return cs_cli_error(&CLI, "%s",
-                            argc - optind < 1 ? "no mesh file given" : "one mesh file at a time");
-    const char *path = argv[optind];
+    int status = 0;
+    const char *path = cs_cli_operand(&CLI, argc, argv, optind, "mesh file", &status);
+    if (!path)
+        return status;
 
     char err[ERRLEN];
     cs_trimesh *mesh = cs_mesh_read(path, err, sizeof err);

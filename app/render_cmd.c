@@ -210,13 +210,10 @@ static int parse_options(int argc, char **argv, render_options *o)
             return cs_cli_option_error(&CLI, c, argv);
         }
     }
-    if (optind >= argc)
-        return cs_cli_error(&CLI, "%s", "no run folder or scene file given");
-    if (argc - optind > 1) {
-        return cs_cli_error(&CLI, "one run folder or scene file only; '%s' is one too many",
-                            argv[optind + 1]);
-    }
-    o->target = argv[optind];
+    int status = 0;
+    o->target = cs_cli_operand(&CLI, argc, argv, optind, "run folder or scene file", &status);
+    if (!o->target)
+        return status;
     if (o->settings.engine == CS_RENDER_PREVIEW && !o->samples_given)
         o->settings.samples = 4;
     return -1;

@@ -224,11 +224,10 @@ static int parse_options(int argc, char **argv, run_options *o)
             return cs_cli_option_error(&CLI, c, argv);
         }
     }
-    if (optind >= argc)
-        return cs_cli_error(&CLI, "%s", "no scene file given");
-    if (argc - optind > 1)
-        return cs_cli_error(&CLI, "one scene file only; '%s' is one too many", argv[optind + 1]);
-    o->scene_path = argv[optind];
+    int status = 0;
+    o->scene_path = cs_cli_operand(&CLI, argc, argv, optind, "scene file", &status);
+    if (!o->scene_path)
+        return status;
     if ((o->render_size || o->render_samples) && !o->render)
         return cs_cli_error(&CLI, "%s", "--size and --samples go with --render ENGINE");
     if (frames) {

@@ -234,11 +234,9 @@ static int parse_options(int argc, char **argv, sweep_options *o)
             return cs_cli_option_error(&CLI, c, argv);
         }
     }
-    if (optind >= argc)
-        return cs_cli_error(&CLI, "%s", "no scene file given");
-    if (argc - optind > 1)
-        return cs_cli_error(&CLI, "one scene file only; '%s' is one too many", argv[optind + 1]);
-    o->scene_path = argv[optind];
+    o->scene_path = cs_cli_operand(&CLI, argc, argv, optind, "scene file", &status);
+    if (!o->scene_path)
+        return status;
     if (o->nknobs == 0)
         return cs_cli_error(&CLI, "%s", "nothing to vary: give --vary KEY=V1,V2,...");
     if (!o->out_dir)

@@ -261,8 +261,6 @@ int main(int argc, char **argv)
     char e2[256];
     cs_trimesh *small = uv_sphere(0.5, 100000);
     cs_levelset *ls = cs_levelset_create(small, 0.01, 3, true, e2, sizeof e2);
-    cs_levelset_info info;
-    cs_levelset_get_info(ls, &info);
     cs_body_def analytic = cs_default_body_def();
     analytic.shape = CS_BODY_SPHERE;
     analytic.radius = 0.5;
@@ -270,11 +268,7 @@ int main(int argc, char **argv)
     analytic.motion.position[1] = 0.5;
     cs_body_def grid = analytic;
     grid.shape = CS_BODY_MESH;
-    grid.phi_fn = cs_levelset_phi;
-    grid.phi_data = ls;
-    grid.phi_bounded = true;
-    memcpy(grid.phi_min, info.min, sizeof info.min);
-    memcpy(grid.phi_max, info.max, sizeof info.max);
+    cs_levelset_attach(&grid, ls);
     printf("| body | seconds per point per step |\n|---|---|\n");
     printf("| analytic sphere | %.0f ns |\n", 1e9 * body_cost(&analytic, 1));
     printf("| level-set sphere (100k triangles, voxel 0.01 m) | %.0f ns |\n",

@@ -22,6 +22,11 @@ extern "C" {
 /* Seconds on the monotonic clock (CLOCK_MONOTONIC): for durations only. */
 double cs_now(void);
 
+/* printf into err (errlen bytes) when err is not NULL: the one way import,
+ * render and app fill an error buffer. */
+void cs_errorf(char *err, size_t errlen, const char *fmt, ...)
+    __attribute__((format(printf, 3, 4)));
+
 /* mkdir -p: creates path and its missing parents; returns 0, or -1 with
  * errno set (ENOTDIR when a part exists and is not a folder). */
 int cs_make_dirs(const char *path);

@@ -67,6 +67,21 @@ void cs_levelset_get_info(const cs_levelset *ls, cs_levelset_info *info);
  * own accessor. */
 double cs_levelset_phi(const void *ls, const double p[3], double grad[3]);
 
+/* Makes the grid body's distance: phi from ls, bounded by the grid's
+ * box (the body's shape and motion are the caller's). */
+static inline void cs_levelset_attach(cs_body_def *body, cs_levelset *ls)
+{
+    cs_levelset_info info;
+    cs_levelset_get_info(ls, &info);
+    body->phi_fn = cs_levelset_phi;
+    body->phi_data = ls;
+    body->phi_bounded = true;
+    for (int k = 0; k < 3; k++) {
+        body->phi_min[k] = info.min[k];
+        body->phi_max[k] = info.max[k];
+    }
+}
+
 /* The library version, part of the cache key ("10.0.1"). */
 const char *cs_levelset_library_version(void);
 

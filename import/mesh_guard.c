@@ -29,16 +29,6 @@
 #include <time.h>
 #include <unistd.h>
 
-void cs_mesh_set_err(char *err, size_t errlen, const char *fmt, ...)
-{
-    if (!err || errlen == 0)
-        return;
-    va_list ap;
-    va_start(ap, fmt);
-    vsnprintf(err, errlen, fmt, ap);
-    va_end(ap);
-}
-
 /* ------------------------------------------------------- byte buffers */
 
 void cs_bytes_put(cs_bytes *b, const void *p, size_t n)

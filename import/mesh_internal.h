@@ -15,10 +15,12 @@
 #include <stdbool.h>
 #include <stddef.h>
 
+#include "common/util.h"
+
 struct aiScene;
 
-void cs_mesh_set_err(char *err, size_t errlen, const char *fmt, ...)
-    __attribute__((format(printf, 3, 4)));
+/* snprintf into err when err is not NULL (common/util.h). */
+#define cs_mesh_set_err cs_errorf
 
 /* ------------------------------------------------------- byte buffers */
 

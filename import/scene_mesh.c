@@ -420,14 +420,9 @@ int cs_sl_build_levelsets(loader *L, cs_scene *s)
         mb->seconds = res.seconds;
         if (res.cache_path[0] && !(mb->cache_path = cs_sl_strdup(res.cache_path)))
             return CS_IMPORT_NOMEM;
+        cs_levelset_attach((cs_body_def *)&s->def.bodies[b], mb->levelset);
         cs_levelset_info info;
         cs_levelset_get_info(mb->levelset, &info);
-        cs_body_def *bd = (cs_body_def *)&s->def.bodies[b];
-        bd->phi_fn = cs_levelset_phi;
-        bd->phi_data = mb->levelset;
-        bd->phi_bounded = true;
-        memcpy(bd->phi_min, info.min, sizeof info.min);
-        memcpy(bd->phi_max, info.max, sizeof info.max);
         char done[1200];
         if (res.from_cache)
             snprintf(done, sizeof done, "read from the cache %s in %.2f s", res.cache_path,

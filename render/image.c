@@ -9,16 +9,6 @@
 #include "common/util.h"
 #include "render/internal.h"
 
-void cs_render_error(char *err, size_t errlen, const char *fmt, ...)
-{
-    if (!err || errlen == 0)
-        return;
-    va_list ap;
-    va_start(ap, fmt);
-    vsnprintf(err, errlen, fmt, ap);
-    va_end(ap);
-}
-
 cs_image *cs_image_create(int width, int height)
 {
     if (width < 1 || height < 1 || width > CS_RENDER_MAX_SIZE || height > CS_RENDER_MAX_SIZE)

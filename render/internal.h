@@ -4,6 +4,8 @@
 #ifndef CS_RENDER_INTERNAL_H
 #define CS_RENDER_INTERNAL_H
 
+#include "common/util.h"
+
 #include <math.h>
 
 #include "render/render.h"
@@ -107,8 +109,7 @@ int cs_preview_draw(cs_preview *engine, const cs_prepared_scene *scene,
                     const cs_render_camera *camera, cs_image *image, cs_render_stats *stats,
                     char *err, size_t errlen);
 
-/* snprintf into err when err is not NULL. */
-void cs_render_error(char *err, size_t errlen, const char *fmt, ...)
-    __attribute__((format(printf, 3, 4)));
+/* snprintf into err when err is not NULL (common/util.h). */
+#define cs_render_error cs_errorf
 
 #endif

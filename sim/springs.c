@@ -1,5 +1,6 @@
 /* springs.c: edge and bending springs, their forces and damping operator. */
 #include <math.h>
+#include <stdbool.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -248,34 +249,19 @@ void cs_springs_add_damping(const cs_springs *s, const double *v, double *out)
     }
 }
 
-double cs_springs_stiffness_bound(const cs_springs *s, const double *mass,
-                                  const unsigned char *is_free, int nparticles)
+/* Gershgorin over the free particles' rows: max_i (2 / m_i) sum of each
+ * spring's term, the term k = E / L0 (damped false) or the damped scheme's
+ * at dt and rest (cs_spring_step_term). -1 when memory runs out. */
+static double rest_row_bound(const cs_springs *s, const double *mass,
+                             const unsigned char *is_free, int nparticles, bool damped,
+                             double dt)
 {
     double *sum = calloc((size_t)nparticles + 1, sizeof *sum);
     if (!sum)
-        return 0;
+        return -1;
     for (int k = 0; k < s->n; k++) {
-        double kk = s->stiffness[k] / s->rest_length[k];
-        sum[s->ends[2 * k]] += kk;
-        sum[s->ends[2 * k + 1]] += kk;
-    }
-    double bound = 0;
-    for (int i = 0; i < nparticles; i++)
-        if (is_free[i] && 2.0 * sum[i] / mass[i] > bound)
-            bound = 2.0 * sum[i] / mass[i];
-    free(sum);
-    return bound;
-}
-
-double cs_springs_rest_step_bound(const cs_springs *s, const double *mass,
-                                  const unsigned char *is_free, int nparticles, double dt)
-{
-    double *sum = calloc((size_t)nparticles + 1, sizeof *sum);
-    if (!sum)
-        return INFINITY;
-    for (int k = 0; k < s->n; k++) {
-        double term = cs_spring_step_term(dt, s->stiffness[k] * s->inv_rest_length[k],
-                                          s->damping[k], 0);
+        double kk = s->stiffness[k] * s->inv_rest_length[k];
+        double term = damped ? cs_spring_step_term(dt, kk, s->damping[k], 0) : kk;
         sum[s->ends[2 * k]] += term;
         sum[s->ends[2 * k + 1]] += term;
     }
@@ -285,6 +271,20 @@ double cs_springs_rest_step_bound(const cs_springs *s, const double *mass,
             bound = 2.0 * sum[i] / mass[i];
     free(sum);
     return bound;
+}
+
+double cs_springs_stiffness_bound(const cs_springs *s, const double *mass,
+                                  const unsigned char *is_free, int nparticles)
+{
+    double bound = rest_row_bound(s, mass, is_free, nparticles, false, 0);
+    return bound < 0 ? 0 : bound;
+}
+
+double cs_springs_rest_step_bound(const cs_springs *s, const double *mass,
+                                  const unsigned char *is_free, int nparticles, double dt)
+{
+    double bound = rest_row_bound(s, mass, is_free, nparticles, true, dt);
+    return bound < 0 ? INFINITY : bound;
 }
 
 double cs_springs_step_bound(const cs_springs *s, const double *mass,

@@ -351,19 +351,13 @@ static void test_particle_on_imported_sphere(void **state)
     const double voxel = 0.04;
     cs_levelset *ls = cs_levelset_create(m, voxel, 3, true, err, sizeof err);
     assert_non_null(ls);
-    cs_levelset_info info;
-    cs_levelset_get_info(ls, &info);
 
     cs_body_def analytic = cs_default_body_def();
     analytic.shape = CS_BODY_SPHERE;
     analytic.radius = 1;
     cs_body_def grid = analytic;
     grid.shape = CS_BODY_MESH;
-    grid.phi_fn = cs_levelset_phi;
-    grid.phi_data = ls;
-    grid.phi_bounded = true;
-    memcpy(grid.phi_min, info.min, sizeof info.min);
-    memcpy(grid.phi_max, info.max, sizeof info.max);
+    cs_levelset_attach(&grid, ls);
 
     /* dropped onto the top from 0.2 m: rests on it */
     const double top[3] = {0, 1.2, 0};

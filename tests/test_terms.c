@@ -61,18 +61,10 @@
 #include <string.h>
 
 #include "sim/sim.h"
+#include "mesh_of.h"
 
 /* ------------------------------------------------------------ helpers */
 
-static cs_trimesh *mesh_of(int nv, const double *x, int nt, const int *tri)
-{
-    cs_trimesh *m = cs_trimesh_create(nv, nt);
-    assert_non_null(m);
-    memcpy(m->x, x, sizeof *x * 3 * (size_t)nv);
-    if (nt > 0)
-        memcpy(m->tri, tri, sizeof *tri * 3 * (size_t)nt);
-    return m;
-}
 
 static cs_sim *create(const cs_sim_def *def)
 {

@@ -20,6 +20,7 @@
 #include <string.h>
 
 #include "sim/sim.h"
+#include "mesh_of.h"
 
 /* A pinned horizontal triangle in y = 0, large enough that everything
  * above it here projects inside it, and a second cloth: a lone particle
@@ -34,15 +35,6 @@ typedef struct pair_scene {
     int floor_cloth, top_offset; /* which cloth is the floor; the top's first particle */
 } pair_scene;
 
-static cs_trimesh *mesh_of(int nv, const double *x, int nt, const int *tri)
-{
-    cs_trimesh *m = cs_trimesh_create(nv, nt);
-    assert_non_null(m);
-    memcpy(m->x, x, sizeof *x * 3 * (size_t)nv);
-    if (nt > 0)
-        memcpy(m->tri, tri, sizeof *tri * 3 * (size_t)nt);
-    return m;
-}
 
 /* floor: 3 vertices (pinned); top: ntop vertices, ttop triangles, all free
  * with velocity v. Steps of dt, frames of steps_per_frame steps. The floor
