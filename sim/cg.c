@@ -21,7 +21,7 @@ static inline void wind_row(const cs_sim *sim, int i, const double *v, double ac
     cs_axpy(-sim->def.wind.drag * sim->wind_area[i] * cs_dot(nrm, v + 3 * i), nrm, acc);
 }
 
-/* out_i = ((M - h D) v)_i for row r (particle i) */
+/* out_i = ((M - (dt/2) D) v)_i for row r (particle i) */
 static inline void system_row(const cs_sim *sim, int r, int i, const double *v, double out[3])
 {
     double acc[3] = {0, 0, 0};
@@ -29,7 +29,7 @@ static inline void system_row(const cs_sim *sim, int r, int i, const double *v, 
     if (sim->wind_normal)
         wind_row(sim, i, v, acc);
     for (int d = 0; d < 3; d++)
-        out[d] = sim->mass[i] * v[3 * i + d] - sim->h * acc[d];
+        out[d] = sim->mass[i] * v[3 * i + d] - sim->half_dt * acc[d];
 }
 
 /* P: fixed velocities and contact normals projected out */
@@ -129,7 +129,7 @@ int cs_cg_solve(cs_sim *sim, double *v0, const double *rhs, double *v, double *w
     double *part_sum = w->partial, *part_max = w->partial + block_count(par);
 
     /* Block Jacobi preconditioner: the inverse of each particle's 3 x 3
-     * diagonal block of M - h D (the damping acts along spring directions,
+     * diagonal block of M - (dt/2) D (the damping acts along spring directions,
      * which a diagonal alone misses), stored as its 6 distinct entries */
 #pragma omp parallel for schedule(static)
     for (int r = 0; r < par->nowned; r++) {
@@ -154,9 +154,9 @@ int cs_cg_solve(cs_sim *sim, double *v0, const double *rhs, double *v, double *w
             B[4] += c * nd[0] * nd[2];
             B[5] += c * nd[1] * nd[2];
         }
-        double m = sim->mass[i], h = sim->h;
-        double a = m + h * B[0], b = m + h * B[1], cz = m + h * B[2];
-        double xy = h * B[3], xz = h * B[4], yz = h * B[5];
+        double m = sim->mass[i], hd = sim->half_dt;
+        double a = m + hd * B[0], b = m + hd * B[1], cz = m + hd * B[2];
+        double xy = hd * B[3], xz = hd * B[4], yz = hd * B[5];
         /* inverse by cofactors; the block is symmetric positive definite */
         double c00 = b * cz - yz * yz, c01 = xz * yz - xy * cz, c02 = xy * yz - xz * b;
         double det = a * c00 + xy * c01 + xz * c02;

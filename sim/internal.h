@@ -77,7 +77,8 @@ struct cs_sim {
     double *wind_normal;          /* 3 per particle, area weighted unit normal */
     double *wind_area;            /* 1 per particle */
 
-    double t, dt, h;              /* h: half step of the current solve */
+    double t, dt, half_dt;        /* dt / 2 of the current solve (h is the
+                                   * paper's repulsion thickness) */
     double frame_end;             /* advance_frame's end time: a step that
                                    * lands within round-off of it lands on it */
     double stable_dt;             /* the limit def.step_limit names, at rest */
@@ -100,14 +101,14 @@ struct cs_sim {
  * repeats; returns how many are left (edges of a mesh, halo entries). */
 int cs_sort_unique_pairs(int *pairs, int n);
 
-/* cg.c: solves P (M - h D) P z = P (rhs - (M - h D) v0) for v = v0 + z,
+/* cg.c: solves P (M - (dt/2) D) P z = P (rhs - (M - (dt/2) D) v0) for v = v0 + z,
  * where P projects out fixed velocities and contact normals, over all
  * ranks (v0's ghosts are refreshed first; v is written where owned).
  * warm (3 per particle, or NULL) holds the damping response of the last
  * solve of the same kind, added to the start, and receives this one's.
  * Returns the iteration count, the same on every rank. */
 int cs_cg_solve(cs_sim *sim, double *v0, const double *rhs, double *v, double *warm);
-/* out = (M - h D) v, D the damping (and wind drag) velocity Jacobian. */
+/* out = (M - (dt/2) D) v, D the damping (and wind drag) velocity Jacobian. */
 void cs_system_apply(const cs_sim *sim, const double *v, double *out);
 /* out += D v (damping plus implicit wind drag). */
 void cs_damping_apply(const cs_sim *sim, const double *v, double *out);

@@ -87,12 +87,13 @@ static void explicit_forces(cs_sim *sim, const double *x)
     }
 }
 
-/* rhs = M v_start + h force */
+/* rhs = M v_start + (dt / 2) force */
 static void momentum_rhs(cs_sim *sim, const double *v_start)
 {
     CS_FOR_OWNED(sim->par, i)
         for (int d = 0; d < 3; d++)
-            sim->rhs[3 * i + d] = sim->mass[i] * v_start[3 * i + d] + sim->h * sim->force[3 * i + d];
+            sim->rhs[3 * i + d] =
+                sim->mass[i] * v_start[3 * i + d] + sim->half_dt * sim->force[3 * i + d];
 }
 
 /* Copies 3 doubles per particle over the given ranges. */
@@ -226,7 +227,7 @@ static const double *stage_velocity_full(cs_sim *sim, const step_state *st)
         CS_FOR_OWNED(par, i) {
             for (int d = 0; d < 3; d++) {
                 int k = 3 * i + d;
-                double v_np = sim->v_star[k] + sim->h / sim->mass[i] * sim->v_next[k];
+                double v_np = sim->v_star[k] + sim->half_dt / sim->mass[i] * sim->v_next[k];
                 sim->v_next[k] = 2.0 * v_np - sim->v_star[k];
             }
             release_separating(sim, i, st->t1, v_p);
@@ -279,7 +280,7 @@ int cs_sim_step(cs_sim *sim, double dt)
                      .bodies = cs_plan_has(&sim->plan, CS_STAGE_BODY_COLLISION)};
     if (fabs(st.t1 - sim->frame_end) <= 1e-9 * dt)
         st.t1 = sim->frame_end; /* the frame's last step lands on its end */
-    sim->h = 0.5 * dt;
+    sim->half_dt = 0.5 * dt;
     /* x (owned and ghosts) is current here; v only where owned */
     copy_ranges(par->local, par->nlocal, sim->x_prev, sim->x);
     CS_FOR_OWNED(par, i)

@@ -176,7 +176,7 @@ static void test_cg_matches_dense_solve(void **state)
     cs_sim *sim = cs_sim_create(&def, NULL, 0);
     assert_non_null(sim);
     int n3 = 3 * sim->n;
-    sim->h = 0.5e-3;
+    sim->half_dt = 0.5e-3;
     cs_springs_prepare(&sim->springs, sim->x);
     for (int i = 0; i < sim->n; i++)
         sim->mode[i] = CS_FREE;
