@@ -10,15 +10,6 @@ NAME=cli_mpi
 SCENES="$2/scenes"
 MPIEXEC=${MPIEXEC:-mpirun}
 
-# mpi_run EXPECTED_STATUS NP ARGS...: clothsim under mpirun.
-mpi_run() {
-    want=$1
-    np=$2
-    shift 2
-    status=0
-    "$MPIEXEC" --oversubscribe -np "$np" "$EXE" "$@" >out.txt 2>err.txt || status=$?
-    [ "$status" -eq "$want" ] || fail "mpirun -np $np clothsim $* exited $status, expected $want"
-}
 
 SMALL="--set cloths.0.grid.resolution=[16,16] --frames 3 -q"
 # shellcheck disable=SC2086

@@ -45,18 +45,11 @@ EOF
 
 MPIEXEC=${MPIEXEC:-mpirun}
 
-# mpi_run EXPECTED_STATUS NP ARGS...: clothsim under mpirun. Without leak
-# checks: Open MPI's own allocations need slow unwinding to be told from
-# ours (tests/lsan-mpi.supp), which doubles the time; cli_mpi checks leaks
-# under mpirun, and every path here runs leak-checked on one rank.
-mpi_run() {
-    want=$1
-    np=$2
-    shift 2
-    status=0
-    ASAN_OPTIONS=detect_leaks=0 "$MPIEXEC" --oversubscribe -np "$np" "$EXE" "$@" >out.txt 2>err.txt || status=$?
-    [ "$status" -eq "$want" ] || fail "mpirun -np $np clothsim $* exited $status, expected $want"
-}
+# mpi_run (harness.sh) without leak checks: Open MPI's own allocations
+# need slow unwinding to be told from ours (tests/lsan-mpi.supp), which
+# doubles the time; cli_mpi checks leaks under mpirun, and every path here
+# runs leak-checked on one rank.
+MPI_ASAN_OPTIONS=detect_leaks=0
 
 DRAPE="$SRC/scenes/drape.yaml"
 SMALL="cloths.0.grid.resolution=[16,16]"

@@ -26,6 +26,18 @@ run() {
     [ "$status" -eq "$want" ] || fail "clothsim $* exited $status, expected $want"
 }
 
+# mpi_run EXPECTED_STATUS NP ARGS...: clothsim under mpirun (MPIEXEC), the
+# same way; MPI_ASAN_OPTIONS, when a test sets it, is ASAN_OPTIONS for it.
+mpi_run() {
+    want=$1
+    np=$2
+    shift 2
+    status=0
+    ASAN_OPTIONS=${MPI_ASAN_OPTIONS:-${ASAN_OPTIONS:-}} "${MPIEXEC:-mpirun}" --oversubscribe \
+        -np "$np" "$EXE" "$@" >out.txt 2>err.txt || status=$?
+    [ "$status" -eq "$want" ] || fail "mpirun -np $np clothsim $* exited $status, expected $want"
+}
+
 # err_has TEXT: stderr contains TEXT (a grep -E pattern).
 err_has() {
     grep -E -q -- "$1" err.txt || fail "stderr lacks '$1'"
