@@ -209,7 +209,8 @@ static int fill_plot(const char *tmp, void *ctx, char *why, size_t whylen)
         pllsty(2);
         plline(2, x, y);
         pllsty(1);
-        plptex(x[0], ymax - 0.05 * (ymax - ymin), 1, 0, 1.05, "reference");
+        /* at the foot of the line: the legend stands at the top right */
+        plptex(x[0], ymin + 0.04 * (ymax - ymin), 1, 0, 1.05, "reference");
     }
     if (opts && cols && styles && nsym && widths && scales && syms && labels && n > 0) {
         PLFLT lw, lh;
