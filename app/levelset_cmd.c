@@ -1,8 +1,10 @@
 /* levelset_cmd.c: `clothsim levelset FILE -o OUT.vdb`: a mesh file to a
  * signed distance grid outside any scene, as a mesh body would get it
  * (holes closed for the sign, interior filled), with what it costs. */
+#include "app/cli.h"
 #include "app/mesh_cmds.h"
 #include "app/run.h"
+#include "common/util.h"
 #include "import/import.h"
 
 #include <getopt.h>
@@ -10,7 +12,6 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
-#include <time.h>
 
 void cs_levelset_help(FILE *out)
 {
@@ -43,22 +44,12 @@ void cs_levelset_help(FILE *out)
           out);
 }
 
-static double now(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
-
-static int usage(const char *fmt, const char *arg)
-{
-    fprintf(stderr, "clothsim levelset: ");
-    fprintf(stderr, fmt, arg);
-    fprintf(stderr, "\nusage: clothsim levelset FILE -o OUT.vdb [--voxel V] [--band N] "
-                    "[--interior MODE] [--node NAME] [--units U] [--scale S]\n"
-                    "                          [--keep-holes]\n");
-    return CS_EXIT_USAGE;
-}
+static const cs_cli CLI = {
+    "levelset",
+    "usage: clothsim levelset FILE -o OUT.vdb [--voxel V] [--band N] [--interior MODE] "
+    "[--node NAME] [--units U] [--scale S]\n"
+    "                          [--keep-holes]\n",
+    NULL, CS_EXIT_USAGE};
 
 static bool positive(const char *s, double *out)
 {
@@ -97,27 +88,27 @@ int cs_levelset_main(int argc, char **argv)
         switch (c) {
         case 'o':
             if (!*optarg)
-                return usage("%s", "--output needs a file name");
+                return cs_cli_error(&CLI, "%s", "--output needs a file name");
             out = optarg;
             break;
         case OPT_VOXEL:
             if (!positive(optarg, &voxel))
-                return usage("--voxel: '%s' is not a number > 0", optarg);
+                return cs_cli_error(&CLI, "--voxel: '%s' is not a number > 0", optarg);
             break;
         case OPT_BAND:
             if (!positive(optarg, &band) || band < 1 || band > 1000)
-                return usage("--band: '%s' is not a number of voxels in [1, 1000]", optarg);
+                return cs_cli_error(&CLI, "--band: '%s' is not a number of voxels in [1, 1000]", optarg);
             break;
         case OPT_NODE:
             place.node = optarg;
             break;
         case OPT_UNITS:
             if (!cs_mesh_units_from_name(optarg, &place.unit_scale))
-                return usage("--units: '%s' is not one of m, cm, mm, km, in, ft", optarg);
+                return cs_cli_error(&CLI, "--units: '%s' is not one of m, cm, mm, km, in, ft", optarg);
             break;
         case OPT_SCALE:
             if (!positive(optarg, &scale))
-                return usage("--scale: '%s' is not a number > 0", optarg);
+                return cs_cli_error(&CLI, "--scale: '%s' is not a number > 0", optarg);
             place.scale[0] = place.scale[1] = place.scale[2] = scale;
             break;
         case OPT_KEEP:
@@ -131,22 +122,21 @@ int cs_levelset_main(int argc, char **argv)
             else if (!strcmp(optarg, "band"))
                 interior = CS_INTERIOR_BAND;
             else
-                return usage("--interior: '%s' is not one of auto, fill, band", optarg);
+                return cs_cli_error(&CLI, "--interior: '%s' is not one of auto, fill, band", optarg);
             break;
         case 'h':
             cs_levelset_help(stdout);
             return CS_EXIT_OK;
-        case ':':
-            return usage("option '%s' needs a value", argv[optind - 1]);
         default:
-            return usage("unknown option '%s'", argv[optind - 1]);
+            return cs_cli_option_error(&CLI, c, argv);
         }
     }
-    if (argc - optind != 1)
-        return usage("%s", argc - optind < 1 ? "no mesh file given" : "one mesh file at a time");
+    int status;
+    const char *path = cs_cli_operand(&CLI, argc, argv, optind, "mesh file", &status);
+    if (!path)
+        return status;
     if (!out)
-        return usage("%s", "no output file given (-o OUT.vdb)");
-    const char *path = argv[optind];
+        return cs_cli_error(&CLI, "%s", "no output file given (-o OUT.vdb)");
 
     char err[1024];
     cs_trimesh *mesh = NULL;
@@ -197,9 +187,9 @@ int cs_levelset_main(int argc, char **argv)
            cs_levelset_estimate_bytes(&rep, voxel, band, fill) / 1e6);
     fflush(stdout);
 
-    double t0 = now();
+    double t0 = cs_now();
     cs_levelset *ls = cs_levelset_create(mesh, voxel, band, fill, err, sizeof err);
-    double convert = now() - t0;
+    double convert = cs_now() - t0;
     cs_trimesh_destroy(mesh);
     if (!ls) {
         fprintf(stderr, "clothsim levelset: %s\n", err);
@@ -218,7 +208,7 @@ int cs_levelset_main(int argc, char **argv)
     snprintf(voxel_text, sizeof voxel_text, "%.17g", voxel);
     const char *keys[] = {"clothsim_source", "clothsim_voxel_size"};
     const char *values[] = {path, voxel_text};
-    t0 = now();
+    t0 = cs_now();
     rc = cs_levelset_write(ls, out, "phi", 2, keys, values, err, sizeof err);
     cs_levelset_destroy(ls);
     if (rc != 0) {
@@ -227,6 +217,6 @@ int cs_levelset_main(int argc, char **argv)
     }
     struct stat st;
     printf("wrote:     %s (%.3g MB) in %.3f s\n", out,
-           stat(out, &st) == 0 ? (double)st.st_size / 1e6 : 0.0, now() - t0);
+           stat(out, &st) == 0 ? (double)st.st_size / 1e6 : 0.0, cs_now() - t0);
     return CS_EXIT_OK;
 }

@@ -21,15 +21,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
-#include <time.h>
 #include <unistd.h>
-
-static double now(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
 
 /* ------------------------------------------------------------ sizes */
 
@@ -215,7 +207,7 @@ int cs_levelset_build(const cs_trimesh *mesh, const cs_levelset_request *req,
 {
     memset(res, 0, sizeof *res);
     compute_key(mesh, req, res->key);
-    double t0 = now();
+    double t0 = cs_now();
     if (req->cache_dir) {
         char label[64];
         safe_label(req->label, label, sizeof label);
@@ -227,7 +219,7 @@ int cs_levelset_build(const cs_trimesh *mesh, const cs_levelset_request *req,
                                          sizeof why);
             if (res->grid) {
                 res->from_cache = true;
-                res->seconds = now() - t0;
+                res->seconds = cs_now() - t0;
                 return CS_IMPORT_OK;
             }
             snprintf(res->cache_note, sizeof res->cache_note, "%s; converted again", why);
@@ -237,7 +229,7 @@ int cs_levelset_build(const cs_trimesh *mesh, const cs_levelset_request *req,
                                    errlen);
     if (!res->grid)
         return strstr(err ? err : "", "out of memory") ? CS_IMPORT_NOMEM : CS_IMPORT_BAD_INPUT;
-    res->seconds = now() - t0;
+    res->seconds = cs_now() - t0;
     if (req->cache_dir) {
         char why[400], voxel[32];
         snprintf(voxel, sizeof voxel, "%.17g", req->voxel_size);

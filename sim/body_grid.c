@@ -12,6 +12,9 @@
 #include <string.h>
 
 #define MAX_DIM 128
+/* cells aimed at: a few per bounded body, so a body's box covers few cells
+ * and a cell few bodies (the query visits each body once anyway) */
+enum { CELLS_PER_BODY = 8, MIN_CELLS = 64 };
 
 static int clampi(int v, int lo, int hi) { return v < lo ? lo : v > hi ? hi : v; }
 
@@ -67,7 +70,7 @@ static bool build_cells(cs_body_grid *g, int nbounded)
         ext[k] = g->uhi[k] - g->ulo[k];
         maxext = fmax(maxext, ext[k]);
     }
-    double target = nbounded * 8.0 < 64 ? 64 : nbounded * 8.0;
+    double target = fmax(MIN_CELLS, (double)CELLS_PER_BODY * nbounded);
     for (int k = 0; k < 3; k++)
         vol *= fmax(ext[k], maxext / MAX_DIM);
     double cell = fmax(cbrt(vol / target), maxext / MAX_DIM);

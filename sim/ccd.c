@@ -6,6 +6,11 @@
 #include "sim/ccd.h"
 #include "sim/vec3.h"
 
+/* Times sampled when the coplanarity cubic vanishes identically: the
+ * pair moves within a plane, and a crossing between samples is caught by
+ * the proximity tests at the sampled times (1/32 of the step apart). */
+enum { COPLANAR_SAMPLES = 32 };
+
 static double poly(double a, double b, double c, double d, double t)
 {
     return ((a * t + b) * t + c) * t + d;
@@ -132,8 +137,8 @@ int cs_coplanarity_times(const double a[3], const double b[3], const double c[3]
                      cs_norm(dg);
     double bound = 64 * DBL_EPSILON * lengths * lengths * lengths;
     if (fabs(p0) + fabs(p1) + fabs(p2) + fabs(p3) <= bound)
-        for (int k = 1; k < 32 && n < CS_CCD_MAX_TIMES; k++)
-            times[n++] = k / 32.0;
+        for (int k = 1; k < COPLANAR_SAMPLES && n < CS_CCD_MAX_TIMES; k++)
+            times[n++] = k / (double)COPLANAR_SAMPLES;
 
     /* ascending, duplicates removed */
     for (int i = 1; i < n; i++)

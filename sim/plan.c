@@ -75,7 +75,9 @@ bool cs_plan_has(const cs_plan *plan, cs_stage stage)
  * and 120 x 120 quads): 4.6 kB with self-collision (BVH, pairs, history,
  * impact zones) and 2.0 kB without. Contacts and zones grow it later (the
  * 100 x 100 drape peaked 10% above its first frame), hence the margin. */
+static const double BYTES_PER_PARTICLE_SELF = 6000.0, BYTES_PER_PARTICLE = 2500.0;
+
 double cs_sim_estimate_bytes(double particles, bool self_collision)
 {
-    return particles * (self_collision ? 6000.0 : 2500.0);
+    return particles * (self_collision ? BYTES_PER_PARTICLE_SELF : BYTES_PER_PARTICLE);
 }

@@ -29,6 +29,8 @@
 
 enum { SPEED_FACTOR = 10 };
 static const double SPEED_FLOOR = 1.0; /* m/s: still scenes */
+/* the strain whose release the bound allows for: a quarter (c / 4 above) */
+static const double RELEASED_STRAIN = 0.25;
 
 void cs_runaway_init(cs_sim *sim)
 {
@@ -84,7 +86,7 @@ double cs_runaway_limit(const cs_sim *sim, double t)
         }
         drive += motion_speed(&body->motion, t, r);
     }
-    return SPEED_FACTOR * drive + 0.25 * sim->runaway.wave_speed + SPEED_FLOOR;
+    return SPEED_FACTOR * drive + RELEASED_STRAIN * sim->runaway.wave_speed + SPEED_FLOOR;
 }
 
 void cs_runaway_begin_step(cs_sim *sim, double t1)

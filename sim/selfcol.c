@@ -10,6 +10,14 @@
 #include "sim/selfcol_private.h"
 #include "sim/vec3.h"
 
+/* Eq. 1: the elastic repulsion impulse is at most m (0.1 d / dt - v_N),
+ * enough to close a tenth of the overlap d in one step */
+static const double REPULSION_CLOSING = 0.1;
+/* Step C's proximity tolerance: a pair that comes this close at a coplanar
+ * time counts as colliding; tiny against both the thickness and the edges
+ * (a round-off guard for the coplanar test, not a physical distance) */
+static const double PROXIMITY_PER_THICKNESS = 1e-3, PROXIMITY_PER_EDGE = 1e-4;
+
 /* ------------------------------------------------------------ topology */
 
 static int pair_push(cs_pair_list *l, const int v[4], const double *s0)
@@ -125,7 +133,8 @@ cs_selfcol *cs_selfcol_create(const cs_sim *sim)
         cs_sub(sim->x + 3 * e[2 * k + 1], sim->x + 3 * e[2 * k], d);
         mean_edge += cs_norm(d) / ne;
     }
-    sc->proximity = fmin(1e-3 * sim->def.self.thickness, 1e-4 * (mean_edge > 0 ? mean_edge : 1));
+    sc->proximity = fmin(PROXIMITY_PER_THICKNESS * sim->def.self.thickness,
+                         PROXIMITY_PER_EDGE * (mean_edge > 0 ? mean_edge : 1));
     for (int i = 0; i < n; i++) {
         sc->inv_mass[i] = sim->is_free[i] ? 1.0 / sim->mass[i] : 0.0;
         sc->zone[i] = -1;
@@ -283,21 +292,23 @@ bool sc_sides_apart(const double *const p[4], int split, double gap)
 }
 
 /* The per-step prune of Section 5: step A keeps pairs generously, so most
- * are not interacting now; an h-thickened box test settles that cheaply. */
-static bool pair_near(const cs_pair *p, bool is_edge, const double *x, double h)
+ * are not interacting now; a box test thickened by the thickness settles
+ * that cheaply. */
+static bool pair_near(const cs_pair *p, bool is_edge, const double *x, double thickness)
 {
     const double *const pts[4] = {x + 3 * p->v[0], x + 3 * p->v[1], x + 3 * p->v[2],
                                   x + 3 * p->v[3]};
-    return !sc_sides_apart(pts, is_edge ? 2 : 3, h);
+    return !sc_sides_apart(pts, is_edge ? 2 : 3, thickness);
 }
 
 /* Bridson's proximity condition for a repulsion: a point/triangle pair
- * only where the point projects inside the triangle (within h over the
- * triangle's size), an edge/edge pair only where the closest points are
- * inside both edges. Elsewhere the other kind of pair is the right one; without this, in-plane neighbours closer than h would push
- * each other out of a flat sheet along its normal. */
+ * only where the point projects inside the triangle (within the thickness
+ * over the triangle's size), an edge/edge pair only where the closest
+ * points are inside both edges. Elsewhere the other kind of pair is the
+ * right one; without this, in-plane neighbours closer than the thickness
+ * would push each other out of a flat sheet along its normal. */
 static bool pair_interior(const cs_pair *p, bool is_edge, const double *x, const double c[4],
-                          double h)
+                          double thickness)
 {
     if (is_edge) { /* closest points clamped to an end: a point's business */
         double s = -c[1], t = c[3];
@@ -318,19 +329,19 @@ static bool pair_interior(const cs_pair *p, bool is_edge, const double *x, const
     cs_cross(r, e2, t1);
     cs_cross(e1, r, t2);
     double w1 = cs_dot(t1, n) / nn, w2 = cs_dot(t2, n) / nn, w0 = 1 - w1 - w2;
-    double tol = h / sqrt(sqrt(nn)); /* h over the triangle's size */
+    double tol = thickness / sqrt(sqrt(nn)); /* thickness over the triangle's size */
     return w0 > -tol && w1 > -tol && w2 > -tol;
 }
 
 bool sc_pair_respond(const cs_selfcol *sc, const cs_pair *p, bool is_edge, const double *x,
                      double *v, const response *r)
 {
-    if (!pair_near(p, is_edge, x, r->h))
+    if (!pair_near(p, is_edge, x, r->thickness))
         return false;
     double c[4], n[3], dist, sd;
     if (!pair_frame(p, is_edge, x, r->epsilon, c, n, &dist, &sd))
         return false;
-    if (!(dist < r->h) || !pair_interior(p, is_edge, x, c, r->h))
+    if (!(dist < r->thickness) || !pair_interior(p, is_edge, x, c, r->thickness))
         return false;
     double inv_m = sc_pair_inverse_mass(sc, p, c);
     if (!(inv_m > 0))
@@ -343,8 +354,8 @@ bool sc_pair_respond(const cs_selfcol *sc, const cs_pair *p, bool is_edge, const
         vn = 0;
     }
     if (r->elastic) {
-        double d = r->h - sd;
-        double J = fmin(r->dt * r->k * d, (0.1 * d / r->dt - vn) / inv_m);
+        double d = r->thickness - sd;
+        double J = fmin(r->dt * r->k * d, (REPULSION_CLOSING * d / r->dt - vn) / inv_m);
         if (J > 0) {
             sc_pair_impulse(sc, p, c, J, n, v);
             dvn += J * inv_m;
@@ -551,11 +562,11 @@ int sc_distribute_boundary(cs_sim *sim, cs_pair_list *pt, cs_pair_list *ee)
 typedef struct finder {
     cs_sim *sim;
     cs_selfcol *sc;
-    double h, span;
+    double thickness, span;
 } finder;
 
-/* Keep a pair only if it can come within h during the span at its present
- * relative velocity: distance in the free state less the largest relative
+/* Keep a pair only if it can come within the thickness during the span at
+ * its present relative velocity: distance in the free state less the largest relative
  * speed between its two sides times the span. (The boxes that found it had
  * to allow for each particle's motion; a patch moving fast but rigidly,
  * like the twisted strip's ends, has little relative motion.) */
@@ -569,7 +580,7 @@ static bool may_meet(const finder *f, const int v[4], int split, double dist)
             cs_sub(vel + 3 * v[i], vel + 3 * v[j], d);
             rel = fmax(rel, cs_norm(d));
         }
-    return dist < f->h + rel * f->span;
+    return dist < f->thickness + rel * f->span;
 }
 
 /* The makers below turn a candidate (a, b) of a traversal into a pair
@@ -686,9 +697,9 @@ void cs_selfcol_find_pairs(cs_sim *sim, double span)
     cs_selfcol *sc = sim->selfcol;
     const double *x = sc->x_free; /* the same on every rank */
     cs_par_allgather(sim->par, sim->v, 3); /* velocities widen the boxes */
-    double h = sim->def.self.thickness;
+    double thickness = sim->def.self.thickness;
     sc->pt.n = sc->ee.n = 0;
-    /* non-aggressive pruning: boxes grow by h/2 plus the distance each
+    /* non-aggressive pruning: boxes grow by half the thickness plus the distance each
      * particle would cover in the span at its present velocity relative to
      * the cloth's mean velocity (a pair's relative speed is at most the sum
      * of its particles' speeds relative to any common velocity, and only
@@ -702,7 +713,7 @@ void cs_selfcol_find_pairs(cs_sim *sim, double span)
     for (int i = 0; i < sc->n; i++) {
         double rel[3];
         cs_sub(sim->v + 3 * i, mean, rel);
-        margin[i] = 0.5 * h + cs_norm(rel) * span;
+        margin[i] = 0.5 * thickness + cs_norm(rel) * span;
         cs_box_empty(sc->pbox + i);
         cs_box_add_point(sc->pbox + i, x + 3 * i);
         cs_box_thicken(sc->pbox + i, margin[i]);
@@ -729,7 +740,7 @@ void cs_selfcol_find_pairs(cs_sim *sim, double span)
     cs_bvh_refit(&sc->ptree, sc->pbox, NULL);
     cs_bvh_refit(&sc->etree, sc->ebox, NULL);
     cs_bvh_refit(&sc->ttree, sc->tbox, NULL);
-    finder f = {sim, sc, h, span};
+    finder f = {sim, sc, thickness, span};
     int rank = sim->par->rank;
     int failed = sc_find_pairs(sc, &sc->ptree, &sc->ttree, false, rank,
                                make_repulsion_point_triangle, &f, &sc->pt) ||

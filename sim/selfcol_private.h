@@ -14,7 +14,7 @@ typedef bool (*pair_maker)(const void *ctx, int a, int b, cs_pair *out);
 typedef struct response {
     bool inelastic, elastic, friction;
     double dt; /* for Eq. 1 */
-    double h, k, mu, epsilon;
+    double thickness, k, mu, epsilon;
 } response;
 
 int sc_distribute_boundary(cs_sim *sim, cs_pair_list *pt, cs_pair_list *ee);

@@ -73,6 +73,10 @@ static bool finite3(const double a[3])
     return isfinite(a[0]) && isfinite(a[1]) && isfinite(a[2]);
 }
 
+/* The core's own check, for programs that fill cs_sim_def themselves: a
+ * scene file's values were checked already, with file and line, against
+ * the ranges of import/scene_keys.def. tests/test_key_ranges.c holds these
+ * checks to that table, so the two cannot drift apart. */
 static int validate(const cs_sim_def *def, char *err, size_t errlen)
 {
     if (def->ncloths < 1)
@@ -82,6 +86,9 @@ static int validate(const cs_sim_def *def, char *err, size_t errlen)
          def->self.zone_iterations < 1))
         return fail(err, errlen, "self-collision needs thickness > 0, stiffness and friction "
                                  ">= 0, zone_iterations >= 1");
+    if (def->self_collision &&
+        !(def->self.edge_flip_epsilon >= -1 && def->self.edge_flip_epsilon <= 1))
+        return fail(err, errlen, "self-collision needs edge_flip_epsilon in [-1, 1]");
     if (!(def->fps > 0))
         return fail(err, errlen, "fps must be > 0");
     if (!(def->dt >= 0) || !(def->dt_safety > 0 && def->dt_safety <= 1))
@@ -92,6 +99,8 @@ static int validate(const cs_sim_def *def, char *err, size_t errlen)
         return fail(err, errlen, "collision_steps, cg_tolerance and cg_max_iterations must be positive");
     if (!finite3(def->gravity))
         return fail(err, errlen, "gravity must be finite");
+    if (!(def->wind.drag >= 0) || !finite3(def->wind.velocity))
+        return fail(err, errlen, "wind drag must be >= 0 and its velocity finite");
     for (int c = 0; c < def->ncloths; c++) {
         const cs_cloth_def *cl = def->cloths + c;
         const cs_cloth_material *m = &cl->material;
@@ -117,6 +126,8 @@ static int validate(const cs_sim_def *def, char *err, size_t errlen)
             return fail(err, errlen, "body %d: unknown shape", b);
         if (body->shape == CS_BODY_MESH && !body->phi_fn) /* never a silent plane */
             return fail(err, errlen, "body %d: a mesh body needs its level set", b);
+        if (!(body->radius > 0))
+            return fail(err, errlen, "body %d: radius must be > 0", b);
         if (!(body->friction >= 0))
             return fail(err, errlen, "body %d: friction must be >= 0", b);
         if (!(body->offset >= 0 && isfinite(body->offset)))
