@@ -235,6 +235,9 @@ static int convert_scripts(loader *L, const cs_raw_cloth *rc, const char *base, 
         snprintf(p, sizeof p, "%s.scripts[%u].motion", base, s);
         err = cs_sl_convert_motion(L, rs->motion, p, pivot, (const double[4]){1, 0, 0, 0},
                                    &vs->motion);
+        snprintf(p, sizeof p, "%s.scripts[%u]", base, s);
+        if (!err)
+            err = cs_sl_num(L, CS_SKEY(script, release), rs->release, p, &vs->release_time);
     }
     free(holder);
     return err;

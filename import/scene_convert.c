@@ -200,6 +200,42 @@ static const char *body_name(const cs_scene *s, int j)
     return s->def.bodies[j].name;
 }
 
+/* The friction schedule: instead of a constant friction, keys in strictly
+ * increasing time with friction >= 0 (held by value in the definition). */
+_Static_assert(CS_BODY_MAX_FRICTION_KEYS == 16,
+               "scene_keys.def's bodies[].friction_keys says at most 16 keys");
+static int convert_friction_keys(loader *L, const cs_raw_body *rb, const char *base,
+                                 cs_body_def *bd)
+{
+    char p[PATH_LEN];
+    int err;
+    bd->nfriction_keys = 0;
+    if (!rb->friction_keys)
+        return CS_IMPORT_OK;
+    snprintf(p, sizeof p, "%s.friction_keys", base);
+    if (rb->friction)
+        return cs_sl_fail(L, p, false, "expected either friction or friction_keys (got both)");
+    if (rb->friction_keys_count > CS_BODY_MAX_FRICTION_KEYS)
+        return cs_sl_fail(L, p, false, "must have at most %d keys (got %u)",
+                          CS_BODY_MAX_FRICTION_KEYS, rb->friction_keys_count);
+    for (unsigned k = 0; k < rb->friction_keys_count; k++) {
+        const cs_raw_friction_key *rk = &rb->friction_keys[k];
+        if (k > 0 && !(rk->time > rb->friction_keys[k - 1].time)) {
+            snprintf(p, sizeof p, "%s.friction_keys[%u].time", base, k);
+            return cs_sl_fail(L, p, true, "must be greater than the previous key's time %g",
+                              rb->friction_keys[k - 1].time);
+        }
+        char key[96];
+        snprintf(key, sizeof key, "%s.friction_keys[%u]", base, k);
+        if ((err = cs_sl_num(L, CS_SKEY(friction_key, friction), &rk->friction, key,
+                             &bd->friction_keys[k].friction)))
+            return err;
+        bd->friction_keys[k].time = rk->time;
+    }
+    bd->nfriction_keys = (int)rb->friction_keys_count;
+    return CS_IMPORT_OK;
+}
+
 static int convert_body(loader *L, const cs_raw_body *rb, int bi, cs_scene *s)
 {
     cs_body_def *bd = (cs_body_def *)&s->def.bodies[bi];
@@ -256,7 +292,8 @@ static int convert_body(loader *L, const cs_raw_body *rb, int bi, cs_scene *s)
         return err;
     if (mesh && (err = cs_sl_convert_mesh_body(L, rb, bi, s)))
         return err;
-    if ((err = cs_sl_convert_keys(L, CS_SEC_body, rb, base, bd)))
+    if ((err = cs_sl_convert_keys(L, CS_SEC_body, rb, base, bd)) ||
+        (err = convert_friction_keys(L, rb, base, bd)))
         return err;
     if (rb->size) {
         if ((err = cs_sl_vec(L, CS_SKEY(body, size), rb->size, base, NULL, bd->half_extents)))

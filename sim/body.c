@@ -120,3 +120,31 @@ void cs_body_def_velocity(const cs_body_def *b, double t, const double x[3], dou
     for (int i = 0; i < 3; i++)
         v[i] = vel[i] + wr[i];
 }
+
+/* Piecewise linear between the keys, constant outside them. The loader
+ * refuses unsorted times and negative values; a definition made in code is
+ * read defensively (at most CS_BODY_MAX_FRICTION_KEYS keys, a key that
+ * does not follow its predecessor taken as a step, never below 0). */
+double cs_body_def_friction(const cs_body_def *b, double t)
+{
+    int n = b->nfriction_keys;
+    if (n <= 0)
+        return b->friction;
+    if (n > CS_BODY_MAX_FRICTION_KEYS)
+        n = CS_BODY_MAX_FRICTION_KEYS;
+    const cs_friction_key *k = b->friction_keys;
+    double mu;
+    if (n == 1 || t <= k[0].time) {
+        mu = k[0].friction;
+    } else if (t >= k[n - 1].time) {
+        mu = k[n - 1].friction;
+    } else {
+        int i = 0;
+        while (i + 2 < n && k[i + 1].time <= t)
+            i++;
+        double span = k[i + 1].time - k[i].time;
+        mu = span > 0 ? k[i].friction + (t - k[i].time) / span * (k[i + 1].friction - k[i].friction)
+                      : k[i + 1].friction;
+    }
+    return mu > 0 ? mu : 0.0; /* NaN too */
+}

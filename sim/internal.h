@@ -18,6 +18,8 @@ typedef struct cs_script_state {
     int *vertices;        /* global particle indices */
     double *local;        /* 3 per vertex: R(0)^T (x0 - c(0)) */
     double radius;        /* the largest |local|: the farthest vertex */
+    double release_time;  /* > 0: let go then (cs_vertex_script) */
+    bool released;
 } cs_script_state;
 
 /* runaway.c: what instability detection knows (see there). */
@@ -127,6 +129,10 @@ bool cs_runaway_end_step(cs_sim *sim);
  * current positions
  * (collective: every rank calls it at the same point). */
 void cs_step_limit_init(cs_sim *sim);
+
+/* step.c: the vertices of scripts with a release time still to come are
+ * held (hold) or, while the step limit is computed for the whole run, free */
+void cs_scripts_hold_releasable(cs_sim *sim, bool hold);
 double cs_step_limit_now(cs_sim *sim);
 
 /* contact.c: Section 6. */

@@ -18,6 +18,8 @@ static const double REPULSION_CLOSING = 0.1;
  * (a round-off guard for the coplanar test, not a physical distance) */
 static const double PROXIMITY_PER_THICKNESS = 1e-3, PROXIMITY_PER_EDGE = 1e-4;
 
+void cs_selfcol_release(cs_selfcol *sc, int i, double mass) { sc->inv_mass[i] = 1.0 / mass; }
+
 /* ------------------------------------------------------------ topology */
 
 static int pair_push(cs_pair_list *l, const int v[4], const double *s0)

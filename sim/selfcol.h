@@ -75,6 +75,9 @@ typedef struct cs_selfcol {
 cs_selfcol *cs_selfcol_create(const cs_sim *sim);
 void cs_selfcol_destroy(cs_selfcol *sc);
 
+/* Particle i, held by a script until now, moves freely from now on. */
+void cs_selfcol_release(cs_selfcol *sc, int i, double mass);
+
 /* After the partition: the trees learn which ranks their primitives go
  * to. Returns 0 or -1 (no memory). */
 int cs_selfcol_set_ranks(cs_sim *sim);

@@ -119,6 +119,10 @@ static int validate(const cs_sim_def *def, char *err, size_t errlen)
             for (int k = 0; k < cl->scripts[s].nvertices; k++)
                 if (cl->scripts[s].vertices[k] < 0 || cl->scripts[s].vertices[k] >= cl->mesh->nv)
                     return fail(err, errlen, "cloth %d: script %d selects a missing vertex", c, s);
+        for (int s = 0; s < cl->nscripts; s++)
+            if (!(cl->scripts[s].release_time >= 0 && isfinite(cl->scripts[s].release_time)))
+                return fail(err, errlen, "cloth %d: script %d: release time must be finite and "
+                                         ">= 0", c, s);
     }
     for (int b = 0; b < def->nbodies; b++) {
         const cs_body_def *body = def->bodies + b;
@@ -130,6 +134,16 @@ static int validate(const cs_sim_def *def, char *err, size_t errlen)
             return fail(err, errlen, "body %d: radius must be > 0", b);
         if (!(body->friction >= 0))
             return fail(err, errlen, "body %d: friction must be >= 0", b);
+        if (body->nfriction_keys < 0 || body->nfriction_keys > CS_BODY_MAX_FRICTION_KEYS)
+            return fail(err, errlen, "body %d: %d friction keys (0 to %d)", b,
+                        body->nfriction_keys, CS_BODY_MAX_FRICTION_KEYS);
+        for (int k = 0; k < body->nfriction_keys; k++) {
+            const cs_friction_key *fk = body->friction_keys + k;
+            if (!(fk->friction >= 0) || !isfinite(fk->friction) || !isfinite(fk->time) ||
+                (k > 0 && !(fk->time > fk[-1].time)))
+                return fail(err, errlen, "body %d: friction key %d: friction must be finite and "
+                                         ">= 0, times finite and strictly increasing", b, k);
+        }
         if (!(body->offset >= 0 && isfinite(body->offset)))
             return fail(err, errlen, "body %d: collision offset must be finite and >= 0", b);
     }
@@ -271,6 +285,7 @@ int cs_sim_create_checked(const cs_sim_def *def, cs_sim **out, char *err, size_t
                 double c0[3];
                 cs_motion_pose(&dst->motion, 0.0, dst->rotation0, c0, NULL, NULL);
                 dst->nvertices = src->nvertices;
+                dst->release_time = src->release_time;
                 dst->vertices = malloc(sizeof *dst->vertices * (size_t)(src->nvertices + 1));
                 dst->local = alloc3(src->nvertices);
                 if (!dst->vertices || !dst->local)
@@ -333,8 +348,13 @@ int cs_sim_create_checked(const cs_sim_def *def, cs_sim **out, char *err, size_t
     /* time step: the stability limits at the rest state (step_limit.c),
      * from all springs on every rank (before the partition keeps its own);
      * with the damped limit, advance_frame chooses the step again from the
-     * tension before each outer step */
+     * tension before each outer step. The undamped limit holds for the
+     * whole run: it is computed with the vertices that scripts will let go
+     * already free (by Cauchy interlacing, held vertices, which remove rows
+     * and columns, can only lower the largest eigenvalue). */
+    cs_scripts_hold_releasable(sim, false);
     cs_step_limit_init(sim);
+    cs_scripts_hold_releasable(sim, true);
     double frame = 1.0 / def->fps;
     double dt_max = def->dt > 0 ? def->dt : def->dt_safety * sim->stable_dt;
     if (dt_max > frame)

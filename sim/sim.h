@@ -122,13 +122,32 @@ typedef enum cs_body_shape {
  * points in parallel). */
 typedef double (*cs_body_phi_fn)(const void *data, const double p[3], double grad[3]);
 
+/* One key of a body's friction schedule: at `time` (s) the Coulomb
+ * coefficient is `friction` (>= 0). */
+typedef struct cs_friction_key {
+    double time;
+    double friction;
+} cs_friction_key;
+
+/* The most keys a friction schedule holds (kept in the definition by value,
+ * so that copying a body copies its schedule). */
+#define CS_BODY_MAX_FRICTION_KEYS 16
+
 typedef struct cs_body_def {
     const char *name;
     cs_body_shape shape;
     double radius;
     double half_extents[3];
     double half_height;
-    double friction;          /* Coulomb coefficient mu */
+    double friction;          /* Coulomb coefficient mu, when nfriction_keys == 0 */
+    /* Friction that changes over time: with nfriction_keys > 0 (at most
+     * CS_BODY_MAX_FRICTION_KEYS), mu(t) is piecewise linear between the
+     * keys, which must have strictly increasing times and friction >= 0;
+     * the first key's value holds before it and the last's after it, and
+     * `friction` is unused. A pure function of time, so it is part of the
+     * definition, not of the state a checkpoint stores. */
+    int nfriction_keys;
+    cs_friction_key friction_keys[CS_BODY_MAX_FRICTION_KEYS];
     /* Collision offset, m: cloth vertices are kept this far outside the
      * surface (phi >= offset), so that a coarse cloth resting on a curved
      * or detailed body does not let the surface poke through between its
@@ -148,6 +167,10 @@ cs_body_def cs_default_body_def(void);
 
 /* Signed distance and unit gradient of a body at world point x, time t. */
 double cs_body_def_phi(const cs_body_def *b, double t, const double x[3], double grad[3]);
+
+/* The body's Coulomb coefficient at time t: `friction`, or its schedule
+ * evaluated at t (see cs_body_def.friction_keys). */
+double cs_body_def_friction(const cs_body_def *b, double t);
 
 /* Velocity at time t of the body material point at world position x. */
 void cs_body_def_velocity(const cs_body_def *b, double t, const double x[3], double v[3]);
@@ -180,6 +203,10 @@ typedef struct cs_vertex_script {
     int nvertices;
     const int *vertices;      /* indices into the cloth's mesh */
     cs_motion motion;
+    /* > 0: the vertices are let go at this time (s), at the first step that
+     * starts then or later, with the script's velocity, and move freely
+     * after; 0: held for the whole run */
+    double release_time;
 } cs_vertex_script;
 
 typedef struct cs_cloth_def {

@@ -24,6 +24,8 @@ static void script_targets(cs_sim *sim, double t)
 {
     for (int s = 0; s < sim->nscripts; s++) {
         cs_script_state *sc = sim->scripts + s;
+        if (sc->released)
+            continue;
         double R[9], c[3], vel[3], w[3];
         cs_motion_pose(&sc->motion, t, R, c, vel, w);
         for (int j = 0; j < sc->nvertices; j++) {
@@ -37,6 +39,35 @@ static void script_targets(cs_sim *sim, double t)
             }
         }
     }
+}
+
+/* Scripts whose release time has come let their vertices go, at the start
+ * of a step (a function of the time alone: every rank and a resumed run
+ * release at the same step). The vertices keep the velocity the script
+ * gave them at the end of the last step. */
+static void release_scripts(cs_sim *sim, double dt)
+{
+    for (int s = 0; s < sim->nscripts; s++) {
+        cs_script_state *sc = sim->scripts + s;
+        if (sc->released || !(sc->release_time > 0) || sim->t < sc->release_time - 1e-9 * dt)
+            continue;
+        sc->released = true;
+        for (int j = 0; j < sc->nvertices; j++) {
+            int g = sc->vertices[j];
+            sim->is_free[g] = 1;
+            sim->active[g] = cs_par_owns(sim->par, g);
+            if (sim->selfcol)
+                cs_selfcol_release(sim->selfcol, g, sim->mass[g]);
+        }
+    }
+}
+
+void cs_scripts_hold_releasable(cs_sim *sim, bool hold)
+{
+    for (int s = 0; s < sim->nscripts; s++)
+        if (sim->scripts[s].release_time > 0 && !sim->scripts[s].released)
+            for (int j = 0; j < sim->scripts[s].nvertices; j++)
+                sim->is_free[sim->scripts[s].vertices[j]] = !hold;
 }
 
 /* Area-weighted vertex normals and a third of the adjacent area. */
@@ -283,6 +314,7 @@ int cs_sim_step(cs_sim *sim, double dt)
     sim->half_dt = 0.5 * dt;
     /* x (owned and ghosts) is current here; v only where owned */
     copy_ranges(par->local, par->nlocal, sim->x_prev, sim->x);
+    release_scripts(sim, dt);
     CS_FOR_OWNED(par, i)
         sim->mode[i] = sim->is_free[i] ? CS_FREE : CS_FIXED;
     cs_runaway_begin_step(sim, st.t1);

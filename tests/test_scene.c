@@ -844,6 +844,89 @@ static void test_reference_example(void **state)
     cs_scene_destroy(s);
 }
 
+/* ------------------------------------------ friction schedules (issue 13) */
+
+/* bodies[].friction_keys: the keys as loaded, and no friction key beside. */
+static void test_friction_keys_loaded(void **state)
+{
+    (void)state;
+    char text[512];
+    snprintf(text, sizeof text, "%s%s", grid2,
+             "bodies:\n"
+             "  - shape: plane\n"
+             "    friction_keys:\n"
+             "      - {time: 0, friction: 0.8}\n"
+             "      - {time: 1.5, friction: 0.05}\n"
+             "  - shape: sphere\n"
+             "    radius: 1\n"
+             "    friction: 0.4\n");
+    cs_scene *s = load_ok(text, 0, NULL);
+    const cs_body_def *b = s->def.bodies;
+    assert_int_equal(b[0].nfriction_keys, 2);
+    assert_true(b[0].friction_keys[0].time == 0 && b[0].friction_keys[0].friction == 0.8);
+    assert_true(b[0].friction_keys[1].time == 1.5 && b[0].friction_keys[1].friction == 0.05);
+    assert_true(fabs(cs_body_def_friction(&b[0], 0.75) - 0.425) < EPS);
+    assert_int_equal(b[1].nfriction_keys, 0);
+    assert_true(cs_body_def_friction(&b[1], 3) == 0.4);
+    cs_scene_destroy(s);
+    /* an override replaces the schedule like any list */
+    const char *ov[] = {"bodies.0.friction_keys=[{time: 2, friction: 0}]"};
+    s = load_ok(text, 1, ov);
+    assert_int_equal(s->def.bodies[0].nfriction_keys, 1);
+    assert_true(cs_body_def_friction(&s->def.bodies[0], 0) == 0);
+    cs_scene_destroy(s);
+}
+
+static void test_friction_keys_errors(void **state)
+{
+    (void)state;
+    expect_error_after_grid("bodies:\n"
+                            "  - shape: plane\n"
+                            "    friction_keys:\n"
+                            "      - {time: 0, friction: 0.8}\n"
+                            "      - {time: 1, friction: -0.1}\n",
+                            "scenes/a.yaml:7: bodies[0].friction_keys[1].friction: must be >= 0 "
+                            "(got -0.1)");
+    expect_error_after_grid("bodies:\n"
+                            "  - shape: plane\n"
+                            "    friction_keys:\n"
+                            "      - {time: 1, friction: 0.8}\n"
+                            "      - {time: 0.5, friction: 0.1}\n",
+                            "scenes/a.yaml:7: bodies[0].friction_keys[1].time: must be greater "
+                            "than the previous key's time 1 (got 0.5)");
+    expect_error_after_grid("bodies:\n"
+                            "  - shape: plane\n"
+                            "    friction_keys:\n"
+                            "      - {time: 1, friction: 0.8}\n"
+                            "      - {time: 1, friction: 0.1}\n",
+                            "scenes/a.yaml:7: bodies[0].friction_keys[1].time: must be greater "
+                            "than the previous key's time 1 (got 1)");
+    expect_error_after_grid("bodies:\n"
+                            "  - shape: plane\n"
+                            "    friction: 0.3\n"
+                            "    friction_keys: [{time: 0, friction: 0.8}]\n",
+                            "scenes/a.yaml:6: bodies[0].friction_keys: expected either friction "
+                            "or friction_keys (got both)");
+    expect_error_after_grid("bodies:\n"
+                            "  - shape: plane\n"
+                            "    friction_keys: [{time: 0}]\n",
+                            "scenes/a.yaml:5: bodies[0].friction_keys[0].friction: required key "
+                            "is missing");
+    char many[1024];
+    int w = snprintf(many, sizeof many, "bodies:\n  - shape: plane\n    friction_keys:\n");
+    for (int k = 0; k < CS_BODY_MAX_FRICTION_KEYS + 1; k++)
+        w += snprintf(many + w, sizeof many - (size_t)w, "      - {time: %d, friction: 0.5}\n", k);
+    expect_error_after_grid(many, "scenes/a.yaml:5: bodies[0].friction_keys: must have at most 16 "
+                                  "keys (got 17)");
+    /* the override names itself */
+    const char *ov[] = {"bodies.0.friction_keys=[{time: 0, friction: -1}]"};
+    char text[512];
+    snprintf(text, sizeof text, "%s%s", grid2, "bodies:\n  - shape: plane\n");
+    expect_error(text, 1, ov,
+                 "--set bodies.0.friction_keys=[{time: 0, friction: -1}]: "
+                 "bodies[0].friction_keys[0].friction: must be >= 0 (got -1)");
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -863,6 +946,8 @@ int main(void)
         cmocka_unit_test(test_files),
         cmocka_unit_test(test_shipped_scenes),
         cmocka_unit_test(test_reference_example),
+        cmocka_unit_test(test_friction_keys_loaded),
+        cmocka_unit_test(test_friction_keys_errors),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -402,7 +402,7 @@ static void test_plan_omits_absent_stages(void **state)
     /* with a body, wind and a pin, all three appear and run */
     cs_body_def body = cs_default_body_def();
     int pinned = 0;
-    cs_vertex_script pin = {1, &pinned, cs_motion_static()};
+    cs_vertex_script pin = {1, &pinned, cs_motion_static(), 0};
     cloth.nscripts = 1;
     cloth.scripts = &pin;
     def.nbodies = 1;
@@ -452,7 +452,7 @@ static void test_automatic_dt_is_stable_across_resolutions(void **state)
         int res[2] = {resolutions[r], resolutions[r]};
         cs_trimesh *mesh = cs_trimesh_create_grid(size, res, q, c);
         int corners[2] = {0, resolutions[r]};
-        cs_vertex_script pin = {2, corners, cs_motion_static()};
+        cs_vertex_script pin = {2, corners, cs_motion_static(), 0};
         cs_cloth_def cloth = {.name = "c", .mesh = mesh, .material = cs_default_cloth_material(),
                               .nscripts = 1, .scripts = &pin};
         cs_sim_def def = cs_default_sim_def();
@@ -490,7 +490,7 @@ static cs_sim *hanging_cloth(cs_trimesh **mesh, double dt, double stiffness, cha
     int res[2] = {8, 8};
     static int corners[2] = {0, 8};
     static cs_vertex_script pin;
-    pin = (cs_vertex_script){2, corners, cs_motion_static()};
+    pin = (cs_vertex_script){2, corners, cs_motion_static(), 0};
     *mesh = cs_trimesh_create_grid(size, res, q, c);
     static cs_cloth_def cloth;
     cloth = (cs_cloth_def){.name = "c", .mesh = *mesh, .material = cs_default_cloth_material(),
@@ -669,7 +669,7 @@ static void test_scripted_vertices_follow_keys(void **state)
     cs_trimesh *mesh = cs_trimesh_create_grid(size, res, q, c);
     int moved[2] = {0, 4};
     cs_keyframe keys[2] = {{0, {0, 0, -0.5}, {1, 0, 0, 0}}, {1, {0, 2, -0.5}, {1, 0, 0, 0}}};
-    cs_vertex_script script = {2, moved, cs_motion_static()};
+    cs_vertex_script script = {2, moved, cs_motion_static(), 0};
     script.motion.kind = CS_MOTION_KEYFRAMES;
     script.motion.position[2] = -0.5;
     script.motion.nkeys = 2;
@@ -713,7 +713,7 @@ static void test_two_cloths_match_each_alone(void **state)
     cs_trimesh *ma = cs_trimesh_create_grid(size_a, ra, q, ca);
     cs_trimesh *mb = cs_trimesh_create_grid(size_b, rb, q, cb);
     int pin_a = 0, pin_b = 2;
-    cs_vertex_script sa = {1, &pin_a, cs_motion_static()}, sb = {1, &pin_b, cs_motion_static()};
+    cs_vertex_script sa = {1, &pin_a, cs_motion_static(), 0}, sb = {1, &pin_b, cs_motion_static(), 0};
     cs_cloth_def cloths[2] = {
         {.name = "a", .mesh = ma, .material = cs_default_cloth_material(), .nscripts = 1, .scripts = &sa},
         {.name = "b", .mesh = mb, .material = cs_default_cloth_material(), .nscripts = 1, .scripts = &sb},

@@ -52,7 +52,7 @@ static void scene_create_ordered(pair_scene *s, const double *floor_x, int ntop,
     s->top = mesh_of(ntop, top_x, ttop, top_tri);
     for (int k = 0; k < 3; k++)
         s->pins[k] = k;
-    s->pin = (cs_vertex_script){3, s->pins, cs_motion_static()};
+    s->pin = (cs_vertex_script){3, s->pins, cs_motion_static(), 0};
     cs_cloth_def *floor_cloth = s->cloths + s->floor_cloth, *top = s->cloths + 1 - s->floor_cloth;
     *floor_cloth = (cs_cloth_def){.name = "floor", .mesh = s->floor,
                                   .material = cs_default_cloth_material(), .nscripts = 1,
