@@ -1,6 +1,6 @@
 /* render_cmd.c: `clothsim render TARGET`: images of a run's frames (TARGET
  * is its output folder) or of a scene's initial state (TARGET is the scene
- * file), and turntables.
+ * file), turntables, and animations of the frames (--animation).
  *
  * A run folder names its scene file and the --set overrides it ran with in
  * summary.json, so the scene is reloaded exactly: cloth colours, bodies
@@ -63,7 +63,13 @@ void cs_render_help(FILE *out)
         "      --wireframe      preview: draw the triangle edges over the shading\n"
         "      --turntable N    N views orbiting the scene's centre, of one frame (the\n"
         "                       last unless --frames names one): view_000.png ...,\n"
-        "                       contact_sheet.png, and turntable.gif if ffmpeg is installed\n"
+        "                       contact_sheet.png, and turntable.mp4 and turntable.gif\n"
+        "                       (12 views a second) if ffmpeg is installed\n"
+        "      --animation      also assemble the rendered frames, in order, into\n"
+        "                       animation.mp4 (H.264, yuv420p) and animation.gif beside\n"
+        "                       them, at the scene's frames per second, with the ffmpeg\n"
+        "                       program; without ffmpeg the PNG frames remain and a note\n"
+        "                       says so (exit status 0)\n"
         "      --set KEY=VALUE  override a scene setting, after the run's own overrides\n"
         "                       (e.g. --set camera.fov=30); repeatable\n"
         "      --scene FILE     the run's scene file, when it has moved since the run\n"
@@ -76,7 +82,8 @@ void cs_render_help(FILE *out)
         "  2    bad input: the scene is invalid, a frame file is missing or holds no\n"
         "       triangles, the size or sample count is out of range, the camera is inside\n"
         "       a body or sees nothing\n"
-        "  4    an image could not be written, or memory ran out\n",
+        "  4    an image could not be written, ffmpeg failed making an animation (its\n"
+        "       message is shown; the PNG images are kept), or memory ran out\n",
         out);
 }
 
@@ -84,7 +91,7 @@ static const cs_cli CLI = {
     "render",
     "usage: clothsim render (RUN_DIR | SCENE) [-o DIR] [--engine embree|preview]\n"
     "                       [--frames LIST] [--size WxH] [--samples N]\n"
-    "                       [--turntable N] [--set KEY=VALUE]...\n"
+    "                       [--turntable N | --animation] [--set KEY=VALUE]...\n"
     "'clothsim render --help' explains every option.\n",
     NULL, CS_EXIT_USAGE};
 
@@ -96,6 +103,7 @@ typedef struct render_options {
     cs_render_settings settings;
     bool samples_given;
     int turntable;
+    bool animation;
     int noverrides;
     char **overrides;
     bool quiet;
@@ -111,7 +119,7 @@ static int value_error(int rc, const char *err)
 
 enum {
     OPT_FRAMES = 256, OPT_SIZE, OPT_SAMPLES, OPT_BOUNCES, OPT_THREADS, OPT_FLAT,
-    OPT_WIREFRAME, OPT_TURNTABLE, OPT_SET, OPT_SCENE
+    OPT_WIREFRAME, OPT_TURNTABLE, OPT_ANIMATION, OPT_SET, OPT_SCENE
 };
 
 /* -1 to go on, else an exit status. */
@@ -128,6 +136,7 @@ static int parse_options(int argc, char **argv, render_options *o)
         {"flat", no_argument, NULL, OPT_FLAT},
         {"wireframe", no_argument, NULL, OPT_WIREFRAME},
         {"turntable", required_argument, NULL, OPT_TURNTABLE},
+        {"animation", no_argument, NULL, OPT_ANIMATION},
         {"set", required_argument, NULL, OPT_SET},
         {"scene", required_argument, NULL, OPT_SCENE},
         {"quiet", no_argument, NULL, 'q'},
@@ -191,6 +200,9 @@ static int parse_options(int argc, char **argv, render_options *o)
             if ((rc = cs_parse_count(optarg, "--turntable", 1, MAX_TURNTABLE, &o->turntable,
                                      err, sizeof err)))
                 return value_error(rc, err);
+            break;
+        case OPT_ANIMATION:
+            o->animation = true;
             break;
         case OPT_SET:
             if (!strchr(optarg, '=') || optarg[0] == '=')
@@ -404,6 +416,129 @@ static int render_frames(job *j, const int *frames, int nframes)
     return CS_EXIT_OK;
 }
 
+/* ------------------------------------------------------------ animations */
+
+/* dir/leaf as an ffmpeg image pattern: a '%' of dir doubled, leaf (which
+ * holds the number's conversion) as it is. 0, or -1 when it does not fit. */
+static int image_pattern(const char *dir, const char *leaf, char *out, size_t len)
+{
+    size_t k = 0;
+    bool fits = true;
+    for (const char *s = dir; *s && fits; s++) {
+        fits = k + 3 < len;
+        if (fits && *s == '%')
+            out[k++] = '%';
+        if (fits)
+            out[k++] = *s;
+    }
+    int n = fits ? snprintf(out + k, len - k, "/%s", leaf) : -1;
+    if (n < 0 || (size_t)n >= len - k) {
+        fprintf(stderr, "clothsim render: the folder name %s is too long for ffmpeg\n", dir);
+        return -1;
+    }
+    return 0;
+}
+
+/* The one way turntables and --animation make an animation: the PNGs that
+ * pattern numbers first .. first + count - 1, at fps, become DIR/BASE.mp4
+ * and DIR/BASE.gif through the ffmpeg program (cs_render_animation); the
+ * files of an earlier animation of that name go first. *made is false when
+ * ffmpeg is not installed. Returns 0, or CS_EXIT_OUTPUT when ffmpeg failed
+ * (its message and ours said; the PNGs stay). */
+static int make_animation(const job *j, const char *pattern, int first, int count, double fps,
+                          const char *base, bool *made)
+{
+    static const char *const exts[] = {"mp4", "gif"};
+    *made = false;
+    for (int e = 0; e < 2; e++) {
+        char path[4300];
+        snprintf(path, sizeof path, "%s/%s.%s", j->out_dir, base, exts[e]);
+        if (unlink(path) != 0 && errno != ENOENT) {
+            fprintf(stderr, "clothsim render: cannot remove the old %s: %s\n", path,
+                    strerror(errno));
+            return CS_EXIT_OUTPUT;
+        }
+    }
+    for (int e = 0; e < 2; e++) {
+        char path[4300], err[ERRLEN];
+        snprintf(path, sizeof path, "%s/%s.%s", j->out_dir, base, exts[e]);
+        int rc = cs_render_animation(pattern, first, count, fps, path, err, sizeof err);
+        if (rc == 0)
+            return CS_EXIT_OK;
+        if (rc < 0) {
+            fprintf(stderr, "clothsim render: %s; the images are kept in %s\n", err,
+                    j->out_dir);
+            return CS_EXIT_OUTPUT;
+        }
+        *made = true;
+        if (!j->o->quiet)
+            printf("animation: %s\n", path);
+    }
+    return CS_EXIT_OK;
+}
+
+/* Links DIR/frame_NNNN.png of the listed frames as TMPDIR/000000.png, ... in
+ * their order (a hard link, else a symbolic one): what ffmpeg's numbered
+ * input needs when the frames are not consecutive. Returns how many were
+ * linked (all on success); the caller removes them. */
+static int link_frames(const char *dir, const char *tmpdir, const int *frames, int nframes)
+{
+    for (int k = 0; k < nframes; k++) {
+        char from[4200], to[4200], rel[64];
+        cs_frame_path(from, sizeof from, dir, frames[k], NULL, "png");
+        snprintf(to, sizeof to, "%s/%06d.png", tmpdir, k);
+        cs_frame_path(rel, sizeof rel, "..", frames[k], NULL, "png");
+        if (link(from, to) != 0 && symlink(rel, to) != 0) {
+            fprintf(stderr, "clothsim render: cannot link %s as %s: %s\n", from, to,
+                    strerror(errno));
+            return k;
+        }
+    }
+    return nframes;
+}
+
+/* --animation: the frames just rendered, in the order listed, at the run's
+ * frames per second. */
+static int render_animation(job *j, const int *frames, int nframes)
+{
+    bool consecutive = true;
+    for (int k = 1; k < nframes; k++)
+        consecutive = consecutive && frames[k] == frames[0] + k;
+    char pattern[8800], tmpdir[4300] = "";
+    int status = CS_EXIT_OK, linked = 0;
+    bool made = false;
+    if (consecutive) {
+        if (image_pattern(j->out_dir, "frame_%04d.png", pattern, sizeof pattern) != 0)
+            status = CS_EXIT_OUTPUT;
+        else
+            status = make_animation(j, pattern, frames[0], nframes, j->fps, "animation", &made);
+    } else {
+        snprintf(tmpdir, sizeof tmpdir, "%s/.animation.XXXXXX", j->out_dir);
+        if (!mkdtemp(tmpdir)) {
+            fprintf(stderr, "clothsim render: cannot create %s: %s\n", tmpdir, strerror(errno));
+            return CS_EXIT_OUTPUT;
+        }
+        linked = link_frames(j->out_dir, tmpdir, frames, nframes);
+        if (linked < nframes)
+            status = CS_EXIT_OUTPUT;
+        else if (image_pattern(tmpdir, "%06d.png", pattern, sizeof pattern) != 0)
+            status = CS_EXIT_OUTPUT;
+        else
+            status = make_animation(j, pattern, 0, nframes, j->fps, "animation", &made);
+        for (int k = 0; k < linked; k++) {
+            char path[4400];
+            snprintf(path, sizeof path, "%s/%06d.png", tmpdir, k);
+            unlink(path);
+        }
+        rmdir(tmpdir);
+    }
+    if (status == CS_EXIT_OK && !made)
+        fprintf(stderr, "clothsim render: no animation: ffmpeg is not installed (not on the "
+                        "PATH); the %d PNG frame%s %s in %s\n", nframes,
+                nframes == 1 ? "" : "s", nframes == 1 ? "is" : "are", j->out_dir);
+    return status;
+}
+
 /* view_<digits>.png of an earlier turntable would join this one's animation. */
 static int remove_old_views(const char *dir)
 {
@@ -496,15 +631,13 @@ static int render_turntable(job *j, int f)
         }
     }
     if (status == CS_EXIT_OK && n > 1) {
-        /* Only if ffmpeg happens to be installed; never required. */
-        char pattern[4200], gif[4200];
-        snprintf(pattern, sizeof pattern, "%s/view_%%03d.png", j->out_dir);
-        snprintf(gif, sizeof gif, "%s/turntable.gif", j->out_dir);
-        int rc = cs_render_animation(pattern, 12.0, gif, err, sizeof err);
-        if (rc == 1 && !j->o->quiet)
-            printf("animation: %s\n", gif);
-        else if (rc < 0)
-            fprintf(stderr, "clothsim render: no animation: %s\n", err);
+        /* Only if ffmpeg is installed; without it the sheet is the result. */
+        char pattern[8800];
+        bool made;
+        if (image_pattern(j->out_dir, "view_%03d.png", pattern, sizeof pattern) != 0)
+            status = CS_EXIT_OUTPUT;
+        else
+            status = make_animation(j, pattern, 0, n, 12.0, "turntable", &made);
     }
     for (int k = 0; thumbs && k < n; k++)
         cs_image_destroy(thumbs[k]);
@@ -592,6 +725,11 @@ int cs_render_main(int argc, char **argv)
             fprintf(stderr, "clothsim render: %s\n", err);
         goto done;
     }
+    if (o.turntable && o.animation) {
+        status = cs_cli_error(&CLI, "%s", "--animation and --turntable do not go together "
+                                          "(a turntable makes its own animation)");
+        goto done;
+    }
     if (o.turntable && nframes != 1) {
         status = cs_cli_error(&CLI, "%s",
                               "--turntable renders one frame: give --frames N (or last)");
@@ -639,6 +777,8 @@ int cs_render_main(int argc, char **argv)
         goto done;
     }
     status = o.turntable ? render_turntable(&j, frames[0]) : render_frames(&j, frames, nframes);
+    if (status == CS_EXIT_OK && o.animation)
+        status = render_animation(&j, frames, nframes);
 
 done:
     frame_geometry_clear(&j.geom);

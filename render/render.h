@@ -186,12 +186,16 @@ int cs_render_contact_sheet(const char *path, int nimages, const cs_image *const
                             const char *const *labels, int columns, int thumb_width, char *err,
                             size_t errlen);
 
-/* An animation (GIF, or MP4 by the file extension) of the numbered PNGs
- * matched by pattern (printf style, e.g. "dir/view_%03d.png", from 0) at fps,
- * made by ffmpeg if one is on the PATH. Returns 1 made, 0 skipped (no
- * ffmpeg), or CS_RENDER_FAILED with err. */
-int cs_render_animation(const char *pattern, double fps, const char *path, char *err,
-                        size_t errlen);
+/* An animation of `count` numbered PNGs matched by pattern (printf style,
+ * e.g. "dir/view_%03d.png"), numbers first .. first + count - 1, at fps
+ * frames a second, made by the ffmpeg program if one is on the PATH: a GIF
+ * (palettegen/paletteuse) when path ends in .gif, else an MP4 (H.264,
+ * yuv420p, sides padded to even). Written atomically (path.tmp, renamed);
+ * ffmpeg's own messages go to stderr. Returns 1 made, 0 skipped (no ffmpeg
+ * on the PATH), or CS_RENDER_FAILED with err (ffmpeg failed, or could not
+ * be started; nothing is left under path). */
+int cs_render_animation(const char *pattern, int first, int count, double fps,
+                        const char *path, char *err, size_t errlen);
 
 #ifdef __cplusplus
 }

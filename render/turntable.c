@@ -1,6 +1,9 @@
-/* turntable.c: what turns a set of views into something to look at: a
- * contact sheet composed with cairo, and an animation when ffmpeg happens to
- * be installed (it is not a dependency; without it the animation is skipped). */
+/* turntable.c: what turns a set of images into something to look at: a
+ * contact sheet composed with cairo, and an animation (MP4 or GIF) of
+ * numbered PNGs through the ffmpeg program -- turntables and `clothsim
+ * render --animation` alike. scripts/install-deps.sh installs ffmpeg, but
+ * the build does not need it: without it the animation is skipped and the
+ * caller says so. */
 #include <cairo.h>
 #include <errno.h>
 #include <spawn.h>
@@ -131,39 +134,76 @@ static bool find_on_path(const char *name, char *out, size_t len)
     return false;
 }
 
-int cs_render_animation(const char *pattern, double fps, const char *path, char *err,
-                        size_t errlen)
+typedef struct animation_job {
+    const char *ffmpeg, *pattern, *rate, *first, *count;
+    bool gif;
+} animation_job;
+
+/* Runs ffmpeg to write the animation as tmp (cs_write_atomic's filler). Its
+ * own messages (-v error) go to our stderr. */
+static int fill_animation(const char *tmp, void *ctx, char *why, size_t whylen)
 {
-    char ffmpeg[4096];
-    if (!find_on_path("ffmpeg", ffmpeg, sizeof ffmpeg))
-        return 0;
-    char rate[32];
-    snprintf(rate, sizeof rate, "%g", fps > 0 ? fps : 12.0);
-    size_t len = strlen(path);
-    bool gif = len >= 4 && strcmp(path + len - 4, ".gif") == 0;
-    /* A palette made from the frames keeps a GIF's colours; MP4 players want
-     * yuv420p and even sides. */
-    const char *filter = gif ? "split[a][b];[a]palettegen[p];[b][p]paletteuse"
-                             : "pad=ceil(iw/2)*2:ceil(ih/2)*2";
-    char *argv[] = {ffmpeg, "-nostdin", "-v", "error", "-y", "-framerate", rate,
-                    "-i", (char *)pattern, "-vf", (char *)filter, "-pix_fmt",
-                    gif ? "pal8" : "yuv420p", (char *)path, NULL};
+    const animation_job *a = ctx;
+    /* A palette made from the frames keeps a GIF's colours; MP4 is H.264 in
+     * yuv420p, which needs even sides, and starts playing before it has all
+     * arrived (faststart). */
+    char *gif_argv[] = {(char *)a->ffmpeg, "-nostdin", "-v", "error", "-y",
+                        "-framerate", (char *)a->rate, "-start_number", (char *)a->first,
+                        "-i", (char *)a->pattern, "-frames:v", (char *)a->count,
+                        "-vf", "split[a][b];[a]palettegen[p];[b][p]paletteuse",
+                        "-f", "gif", (char *)tmp, NULL};
+    char *mp4_argv[] = {(char *)a->ffmpeg, "-nostdin", "-v", "error", "-y",
+                        "-framerate", (char *)a->rate, "-start_number", (char *)a->first,
+                        "-i", (char *)a->pattern, "-frames:v", (char *)a->count,
+                        "-vf", "pad=ceil(iw/2)*2:ceil(ih/2)*2", "-c:v", "libx264",
+                        "-pix_fmt", "yuv420p", "-movflags", "+faststart",
+                        "-f", "mp4", (char *)tmp, NULL};
     pid_t pid;
-    int rc = posix_spawn(&pid, ffmpeg, NULL, NULL, argv, environ);
+    int rc = posix_spawn(&pid, a->ffmpeg, NULL, NULL, a->gif ? gif_argv : mp4_argv, environ);
     if (rc != 0) {
-        cs_render_error(err, errlen, "cannot start %s: %s", ffmpeg, strerror(rc));
-        return CS_RENDER_FAILED;
+        snprintf(why, whylen, "cannot start %s: %s", a->ffmpeg, strerror(rc));
+        return -1;
     }
     int status = 0;
     while (waitpid(pid, &status, 0) < 0)
         if (errno != EINTR) {
-            cs_render_error(err, errlen, "waiting for ffmpeg: %s", strerror(errno));
-            return CS_RENDER_FAILED;
+            snprintf(why, whylen, "waiting for ffmpeg: %s", strerror(errno));
+            return -1;
         }
-    if (!WIFEXITED(status) || WEXITSTATUS(status) != 0) {
-        cs_render_error(err, errlen, "ffmpeg could not make %s (status %d)", path,
-                        WIFEXITED(status) ? WEXITSTATUS(status) : -1);
-        return CS_RENDER_FAILED;
+    if (WIFSIGNALED(status)) {
+        snprintf(why, whylen, "ffmpeg was killed by signal %d", WTERMSIG(status));
+        return -1;
     }
+    if (!WIFEXITED(status) || WEXITSTATUS(status) != 0) {
+        snprintf(why, whylen, "ffmpeg failed (exit status %d)",
+                 WIFEXITED(status) ? WEXITSTATUS(status) : -1);
+        return -1;
+    }
+    if (access(tmp, F_OK) != 0) {
+        snprintf(why, whylen, "ffmpeg exited 0 but wrote nothing");
+        return -1;
+    }
+    return 0;
+}
+
+int cs_render_animation(const char *pattern, int first, int count, double fps,
+                        const char *path, char *err, size_t errlen)
+{
+    char ffmpeg[4096];
+    if (!find_on_path("ffmpeg", ffmpeg, sizeof ffmpeg))
+        return 0;
+    if (first < 0 || count < 1) {
+        cs_render_error(err, errlen, "animation %s: no frames", path);
+        return CS_RENDER_BAD_INPUT;
+    }
+    char rate[32], first_s[16], count_s[16];
+    snprintf(rate, sizeof rate, "%.17g", fps > 0 ? fps : 12.0);
+    snprintf(first_s, sizeof first_s, "%d", first);
+    snprintf(count_s, sizeof count_s, "%d", count);
+    size_t len = strlen(path);
+    animation_job a = {ffmpeg, pattern, rate, first_s, count_s,
+                       len >= 4 && strcmp(path + len - 4, ".gif") == 0};
+    if (cs_write_atomic(path, false, fill_animation, &a, err, errlen) != 0)
+        return CS_RENDER_FAILED;
     return 1;
 }

@@ -5,7 +5,7 @@ set -eu
 PACKAGES="build-essential cmake pkg-config \
   libembree-dev libassimp-dev libosmesa6-dev libopenmpi-dev openmpi-bin \
   libopenvdb-dev libboost-iostreams-dev libpng-dev libcyaml-dev libyaml-dev \
-  libcjson-dev libcmocka-dev libcairo2-dev libgmp-dev libhdf5-dev libxxhash-dev libplplot-dev plplot-driver-cairo valgrind python3"
+  libcjson-dev libcmocka-dev libcairo2-dev libgmp-dev libhdf5-dev libxxhash-dev libplplot-dev plplot-driver-cairo valgrind python3 ffmpeg"
 missing=""
 for p in $PACKAGES; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing="$missing $p"
