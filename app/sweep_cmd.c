@@ -6,10 +6,12 @@
  * scene with each one's overrides (a bad key or value stops everything
  * before a folder is made, exit 2); then run them one after another, the
  * reference first, each a child `clothsim run` into a folder of its own;
- * last, read every run back, compare its frames with the reference's and
- * write DIR/sweep.csv, DIR/sweep.md and DIR/sweep.png.
+ * last, read every run back, compare its frames with the reference's (and
+ * with --analytic with the analytic solution) and write the tables and
+ * pictures (sweep_output.c).
  */
 #include "app/sweep_cmd.h"
+#include "app/sweep_internal.h"
 
 #include "app/cli.h"
 #include "app/outdir.h"
@@ -67,8 +69,10 @@ void cs_sweep_help(FILE *out)
         "                         DIR/run_NNN_KEY=V.../ (frames, summary.json, run.log,\n"
         "                         errors.csv: the error per frame), DIR/reference_KEY=V.../\n"
         "                         when the reference is no combination, and DIR/sweep.csv,\n"
-        "                         DIR/sweep.md (a row per run) and DIR/sweep.png (error\n"
-        "                         against seconds, log-log, a curve per knob)\n"
+        "                         DIR/sweep.md (a row per run), DIR/sweep.png (error\n"
+        "                         against seconds, log-log, a curve per knob) and\n"
+        "                         DIR/cumulative_time.png (wall seconds summed over the\n"
+        "                         frames, a curve per run)\n"
         "      --vary KEY=V1,V2,...\n"
         "                         a knob: KEY and values as for 'run --set' (a value\n"
         "                         may be a YAML list, [40,40]); repeatable, every\n"
@@ -80,12 +84,25 @@ void cs_sweep_help(FILE *out)
         "                         time.cg_max_iterations, self_collision.zone_iterations,\n"
         "                         cloths.N.grid.resolution); required for other keys\n"
         "      --set KEY=VALUE    a setting of every run, e.g. --set time.frames=10\n"
+        "      --repeat N         run each N times, one after another, and take the\n"
+        "                         median wall seconds (default 1; the folder keeps the\n"
+        "                         last run's frames and frames.jsonl)\n"
+        "      --analytic incline\n"
+        "                         measure each run against the analytic solution of a\n"
+        "                         rigid body sliding with Coulomb friction on the scene's\n"
+        "                         one plane (Figs. 7, 8): errors.csv and the tables get\n"
+        "                         analytic_m (centre of mass against the analytic one,\n"
+        "                         m), errors.csv the distance down the slope of both\n"
+        "                         (travel_m, travel_analytic_m), sweep.png draws\n"
+        "                         analytic_m, DIR/trajectory.png the distance against\n"
+        "                         time; a knob without a tightest value needs no\n"
+        "                         --reference (its first value is the reference)\n"
         "  -q, --quiet            no progress lines\n"
         "  -h, --help             show this help\n"
         "\n"
         "Errors (metres, the largest over frames; README, 'clothsim sweep'): vertex\n"
         "RMS and largest distance when the vertex counts match; centre of mass,\n"
-        "bounding box and Hausdorff distance always.\n"
+        "bounding box and Hausdorff distance always; analytic_m with --analytic.\n"
         "\n"
         "exit status:\n"
         "  0    every run finished\n"
@@ -101,27 +118,12 @@ void cs_sweep_help(FILE *out)
 static const cs_cli CLI = {
     "sweep",
     "usage: clothsim sweep SCENE --vary KEY=V1,V2,... [--vary ...] [--reference KEY=V]...\n"
-    "                      [--set KEY=VALUE]... -o DIR [--quiet]\n"
+    "                      [--set KEY=VALUE]... [--analytic incline] [--repeat N] -o DIR\n"
+    "                      [--quiet]\n"
     "'clothsim sweep --help' explains every option.\n",
     NULL, CS_EXIT_USAGE};
 
 /* ---------------------------------------------------------------- options */
-
-typedef struct knob {
-    char *key;
-    int n;
-    char **values;
-    const char *ref;  /* the reference's value: values[k] or --reference's */
-} knob;
-
-typedef struct sweep_options {
-    const char *scene_path, *out_dir;
-    bool quiet;
-    int nknobs, nrefs, nsets;
-    knob *knobs;
-    char **refs;       /* --reference KEY=V, as given */
-    char **sets;       /* --set KEY=VALUE, as given */
-} sweep_options;
 
 static void free_options(sweep_options *o)
 {
@@ -176,7 +178,7 @@ static int parse_vary(const char *arg, knob *k)
     return -1;
 }
 
-enum { OPT_VARY = 256, OPT_REFERENCE, OPT_SET };
+enum { OPT_VARY = 256, OPT_REFERENCE, OPT_SET, OPT_ANALYTIC, OPT_REPEAT };
 
 /* Returns -1 to go on, else an exit status. */
 static int parse_options(int argc, char **argv, sweep_options *o)
@@ -186,11 +188,14 @@ static int parse_options(int argc, char **argv, sweep_options *o)
         {"vary", required_argument, NULL, OPT_VARY},
         {"reference", required_argument, NULL, OPT_REFERENCE},
         {"set", required_argument, NULL, OPT_SET},
+        {"analytic", required_argument, NULL, OPT_ANALYTIC},
+        {"repeat", required_argument, NULL, OPT_REPEAT},
         {"quiet", no_argument, NULL, 'q'},
         {"help", no_argument, NULL, 'h'},
         {NULL, 0, NULL, 0},
     };
     memset(o, 0, sizeof *o);
+    o->repeat = 1;
     o->knobs = calloc((size_t)argc + 1, sizeof *o->knobs);
     o->refs = calloc((size_t)argc + 1, sizeof *o->refs);
     o->sets = calloc((size_t)argc + 1, sizeof *o->sets);
@@ -224,6 +229,21 @@ static int parse_options(int argc, char **argv, sweep_options *o)
             else
                 o->refs[o->nrefs++] = optarg;
             break;
+        case OPT_ANALYTIC: /* the command's own option: a bad one is a usage error */
+            if (strcmp(optarg, "incline") != 0)
+                return cs_cli_error(&CLI, "--analytic: '%s' is no analytic solution known "
+                                          "(there is: incline)", optarg);
+            o->analytic = optarg;
+            break;
+        case OPT_REPEAT: {
+            char *end;
+            long n = strtol(optarg, &end, 10);
+            if (end == optarg || *end || n < 1 || n > 100)
+                return cs_cli_error(&CLI, "--repeat: '%s' is not a whole number from 1 to 100",
+                                    optarg);
+            o->repeat = (int)n;
+            break;
+        }
         case 'q':
             o->quiet = true;
             break;
@@ -268,6 +288,10 @@ static int pick_references(sweep_options *o)
         for (int t = 0; t < NTIGHTEST && rule < 0; t++)
             if (cs_sweep_key_matches(TIGHTEST[t].key, k->key))
                 rule = t;
+        if (rule < 0 && o->analytic) { /* the analytic solution is the yardstick */
+            k->ref = k->values[0];
+            continue;
+        }
         if (rule < 0)
             return bad_setting("no rule says which value of %s is the tightest: give "
                                "--reference KEY=VALUE",
@@ -290,20 +314,6 @@ static int pick_references(sweep_options *o)
 
 /* ----------------------------------------------------------------- runs */
 
-typedef struct sweep_run {
-    int number;          /* 1.. for combinations, 0 for a separate reference */
-    const char **value;  /* per knob */
-    char **overrides;    /* --set ones, then "KEY=VALUE" per knob (owned) */
-    int noverrides;
-    char *dir;           /* DIR/run_NNN_... or DIR/reference_... */
-    bool reference;
-    int exit;            /* the child's exit status; -1 not run */
-    double wall;         /* its wall seconds */
-    bool have_counts, have_error;
-    cs_sweep_counts counts;
-    cs_sweep_error error;
-} sweep_run;
-
 static void free_runs(sweep_run *runs, int nruns, int nsets)
 {
     for (int r = 0; runs && r < nruns; r++) {
@@ -312,6 +322,8 @@ static void free_runs(sweep_run *runs, int nruns, int nsets)
         free(runs[r].overrides);
         free(runs[r].value);
         free(runs[r].dir);
+        free(runs[r].travel);
+        cs_sweep_counts_free(&runs[r].counts);
     }
     free(runs);
 }
@@ -449,14 +461,24 @@ static int validate_values(const sweep_options *o)
 }
 
 /* Every run's overrides together; the reference's scene is kept (the
- * cloths' names). Returns -1 to go on, else an exit status. */
-static int validate(const sweep_options *o, const sweep_run *runs, int nruns, int ref,
+ * cloths' names); with --analytic each run's incline. Returns -1 to go on,
+ * else an exit status. */
+static int validate(const sweep_options *o, sweep_run *runs, int nruns, int ref,
                     cs_scene **ref_scene)
 {
     int status = -1;
-    for (int i = 0; i < nruns && status < 0; i++)
-        status = load(o->scene_path, runs[i].noverrides, runs[i].overrides,
-                      i == ref ? ref_scene : NULL);
+    for (int i = 0; i < nruns && status < 0; i++) {
+        cs_scene *scene = NULL;
+        char err[ERRLEN];
+        status = load(o->scene_path, runs[i].noverrides, runs[i].overrides, &scene);
+        if (status < 0 && o->analytic &&
+            cs_sweep_analytic_init(&scene->def, &runs[i].analytic, err, sizeof err) != 0)
+            status = bad_setting("%s", err);
+        if (status < 0 && i == ref)
+            *ref_scene = scene;
+        else if (scene)
+            cs_scene_destroy(scene);
+    }
     return status;
 }
 /* ------------------------------------------------------------ executing */
@@ -489,6 +511,12 @@ static int run_child(const sweep_options *o, const sweep_run *r, char *err, size
 }
 
 static volatile sig_atomic_t interrupted = 0;
+
+static int compare_doubles(const void *a, const void *b)
+{
+    double x = *(const double *)a, y = *(const double *)b;
+    return (x > y) - (x < y);
+}
 
 static void on_signal(int sig)
 {
@@ -523,10 +551,16 @@ static int execute(const sweep_options *o, sweep_run *runs, int nruns, int ref)
                 fprintf(stderr, "%s%s=%s", k ? " " : "", o->knobs[k].key, r->value[k]);
             fprintf(stderr, "%s) ... ETA %s\n", r->reference ? ", reference" : "", eta);
         }
-        double t0 = cs_now();
-        r->exit = run_child(o, r, err, sizeof err);
-        r->wall = cs_now() - t0;
-        spent += r->wall;
+        double walls[100];
+        int n = 0;
+        do { /* --repeat: again while it finishes; the median of the seconds */
+            double t0 = cs_now();
+            r->exit = run_child(o, r, err, sizeof err);
+            walls[n] = cs_now() - t0;
+            spent += walls[n++] / o->repeat;
+        } while (n < o->repeat && r->exit == CS_EXIT_OK && !interrupted);
+        qsort(walls, (size_t)n, sizeof *walls, compare_doubles);
+        r->wall = n % 2 ? walls[n / 2] : 0.5 * (walls[n / 2 - 1] + walls[n / 2]);
         if (r->exit < 0) {
             fprintf(stderr, "clothsim sweep: %s\n", err);
             return CS_EXIT_OUTPUT;
@@ -540,6 +574,10 @@ static int execute(const sweep_options *o, sweep_run *runs, int nruns, int ref)
             fprintf(stderr, "clothsim sweep: run %d exited with status %d; see %s/run.log\n",
                     done + 1, r->exit, r->dir);
     }
+    /* the runs are over: measuring and writing stop at a signal as usual */
+    sa.sa_handler = SIG_DFL;
+    sigaction(SIGINT, &sa, NULL);
+    sigaction(SIGTERM, &sa, NULL);
     return -1;
 }
 
@@ -547,7 +585,8 @@ static int execute(const sweep_options *o, sweep_run *runs, int nruns, int ref)
 
 /* Each run's counters and its error against the reference (per frame in
  * its folder's errors.csv). Returns -1 to go on, else an exit status. */
-static int measure_runs(sweep_run *runs, int nruns, int ref, const cs_scene *scene)
+static int measure_runs(const sweep_options *o, sweep_run *runs, int nruns, int ref,
+                        const cs_scene *scene)
 {
     char err[ERRLEN];
     cs_run_info info;
@@ -556,6 +595,10 @@ static int measure_runs(sweep_run *runs, int nruns, int ref, const cs_scene *sce
         return CS_EXIT_UNSTABLE;
     }
     int ref_frames = info.frames_written;
+    /* The frames are this sweep's own, written by its child runs: nothing
+     * untrusted to read in a process of its own (import/mesh_guard.c), and
+     * a process per frame file costs more than the comparison. */
+    setenv("CLOTHSIM_IMPORT_ISOLATION", "0", 0);
     cs_frame_layout layout;
     int ncloths = scene->def.ncloths;
     const char **names = calloc((size_t)ncloths + 1, sizeof *names);
@@ -582,8 +625,13 @@ static int measure_runs(sweep_run *runs, int nruns, int ref, const cs_scene *sce
                                                            : ref_frames;
         char *path = cs_path_join(r->dir, "errors.csv");
         FILE *per_frame = path ? fopen(path, "w") : NULL;
-        rc = cs_sweep_compare(&layout, r->dir, runs[ref].dir, frames, per_frame, &r->error,
-                              err, sizeof err);
+        r->nframes = frames;
+        if (o->analytic && !(r->travel = calloc((size_t)frames + 1, sizeof *r->travel)))
+            rc = CS_EXIT_OUTPUT, snprintf(err, sizeof err, "out of memory");
+        else
+            rc = cs_sweep_compare(&layout, r->dir, runs[ref].dir, frames,
+                                  o->analytic ? &r->analytic : NULL, per_frame, r->travel,
+                                  &r->error, err, sizeof err);
         if (per_frame && fclose(per_frame) != 0 && rc == CS_EXIT_OK) {
             snprintf(err, sizeof err, "cannot write %s: %s", path, strerror(errno));
             rc = CS_EXIT_OUTPUT;
@@ -600,155 +648,6 @@ static int measure_runs(sweep_run *runs, int nruns, int ref, const cs_scene *sce
     }
     cs_frame_layout_free(&layout);
     return status;
-}
-
-/* ---------------------------------------------------------------- tables */
-
-static const char *COLUMNS[] = {"reference", "status", "wall_s", "steps", "cg_iterations",
-                                "collisions", "impact_zones", "intersecting_pairs_max",
-                                "body_penetration_max_m", "vertex_rms_m", "vertex_max_m",
-                                "com_m", "bbox_m", "hausdorff_m", "error_m"};
-#define NCOLUMNS ((int)(sizeof COLUMNS / sizeof COLUMNS[0]))
-
-/* A number as a cell: "" when not applicable (NaN, or < 0: not counted). */
-static char *num_cell(double v)
-{
-    char buf[32] = "";
-    if (!isnan(v) && v >= 0)
-        snprintf(buf, sizeof buf, "%.6g", v);
-    return strdup(buf);
-}
-
-/* Fills t (header and cells, a row per run; cs_sweep_table in
- * sweep_cmd.h). Returns 0, or -1 when memory runs out (t freed by caller). */
-static int build_table(const sweep_options *o, const sweep_run *runs, int nruns,
-                       cs_sweep_table *t, const char **header)
-{
-    t->ncols = 2 + o->nknobs + NCOLUMNS;
-    t->nrows = nruns;
-    t->header = header;
-    header[0] = "run";
-    header[1] = "folder";
-    for (int k = 0; k < o->nknobs; k++)
-        header[2 + k] = o->knobs[k].key;
-    for (int c = 0; c < NCOLUMNS; c++)
-        header[2 + o->nknobs + c] = COLUMNS[c];
-    t->cells = calloc((size_t)t->ncols * (size_t)nruns + 1, sizeof *t->cells);
-    if (!t->cells)
-        return -1;
-    for (int i = 0; i < nruns; i++) {
-        const sweep_run *r = &runs[i];
-        char **row = t->cells + (size_t)i * t->ncols, num[16];
-        const cs_sweep_counts *c = &r->counts;
-        const cs_sweep_error *e = &r->error;
-        bool n = r->have_counts, m = r->have_error;
-        snprintf(num, sizeof num, "%d", r->number);
-        row[0] = strdup(r->number ? num : "reference");
-        row[1] = strdup(strrchr(r->dir, '/') ? strrchr(r->dir, '/') + 1 : r->dir);
-        for (int k = 0; k < o->nknobs; k++)
-            row[2 + k] = strdup(r->value[k]);
-        row = row + 2 + o->nknobs;
-        row[0] = strdup(r->reference ? "yes" : "no");
-        row[1] = strdup(n ? c->status : r->exit < 0 ? "not run" : "failed");
-        double nums[NCOLUMNS - 2] = {
-            r->exit >= 0 ? r->wall : NAN, n ? (double)c->steps : NAN,
-            n ? (double)c->cg_iterations : NAN, n ? (double)c->collisions : NAN,
-            n ? (double)c->impact_zones : NAN, n ? (double)c->intersections : NAN,
-            n ? c->penetration : NAN, m ? e->vertex_rms : NAN, m ? e->vertex_max : NAN,
-            m ? e->com : NAN, m ? e->bbox : NAN, m ? e->hausdorff : NAN,
-            m ? cs_sweep_error_headline(e) : NAN};
-        for (int k = 0; k < NCOLUMNS - 2; k++)
-            row[2 + k] = num_cell(nums[k]);
-    }
-    for (size_t k = 0; k < (size_t)t->ncols * (size_t)nruns; k++)
-        if (!t->cells[k])
-            return -1;
-    return 0;
-}
-
-static void free_table(cs_sweep_table *t)
-{
-    for (size_t k = 0; t->cells && k < (size_t)t->ncols * (size_t)t->nrows; k++)
-        free(t->cells[k]);
-    free(t->cells);
-}
-
-static int compare_seconds(const void *a, const void *b)
-{
-    const double *x = a, *y = b;
-    return (x[0] > y[0]) - (x[0] < y[0]);
-}
-
-/* sweep.png: per knob the runs whose other knobs are at the reference's
- * values. Returns 0, or -1 with err. */
-static int plot(const sweep_options *o, const sweep_run *runs, int nruns, int ref,
-                char *err, size_t errlen)
-{
-    cs_sweep_curve *curves = calloc((size_t)o->nknobs, sizeof *curves);
-    double *pairs = calloc(2 * (size_t)nruns + 1, sizeof *pairs);
-    double *xy = calloc(2 * (size_t)nruns * (size_t)o->nknobs + 1, sizeof *xy);
-    int rc = -1;
-    if (!curves || !pairs || !xy) {
-        snprintf(err, errlen, "out of memory");
-        goto done;
-    }
-    for (int k = 0; k < o->nknobs; k++) {
-        int n = 0;
-        for (int i = 0; i < nruns; i++) {
-            const sweep_run *r = &runs[i];
-            bool on_curve = r->have_error && r->exit == CS_EXIT_OK && r->wall > 0;
-            for (int j = 0; j < o->nknobs && on_curve; j++)
-                on_curve = j == k || strcmp(r->value[j], o->knobs[j].ref) == 0;
-            double e = on_curve ? cs_sweep_error_headline(&r->error) : NAN;
-            if (e > 0 && isfinite(e)) { /* log axes: the reference's 0 is the line */
-                pairs[2 * n] = r->wall;
-                pairs[2 * n++ + 1] = e;
-            }
-        }
-        qsort(pairs, (size_t)n, 2 * sizeof *pairs, compare_seconds);
-        curves[k].label = o->knobs[k].key;
-        curves[k].n = n;
-        curves[k].seconds = xy + 2 * (size_t)nruns * k;
-        curves[k].error = curves[k].seconds + nruns;
-        for (int i = 0; i < n; i++) {
-            curves[k].seconds[i] = pairs[2 * i];
-            curves[k].error[i] = pairs[2 * i + 1];
-        }
-    }
-    char *path = cs_path_join(o->out_dir, "sweep.png");
-    if (!path)
-        snprintf(err, errlen, "out of memory");
-    else
-        rc = cs_sweep_plot(path, curves, o->nknobs, runs[ref].wall, err, errlen);
-    free(path);
-done:
-    free(curves);
-    free(pairs);
-    free(xy);
-    return rc;
-}
-
-static int report(const sweep_options *o, const sweep_run *runs, int nruns, int ref)
-{
-    char err[ERRLEN] = "out of memory";
-    const char **header = calloc((size_t)(2 + o->nknobs + NCOLUMNS), sizeof *header);
-    cs_sweep_table t = {0};
-    int rc = header ? build_table(o, runs, nruns, &t, header) : -1;
-    const char *names[] = {"sweep.csv", "sweep.md"};
-    for (int m = 0; m < 2 && rc == 0; m++) {
-        char *path = cs_path_join(o->out_dir, names[m]);
-        rc = path ? cs_sweep_write_table(path, &t, m == 1, err, sizeof err) : -1;
-        free(path);
-    }
-    free_table(&t);
-    free(header);
-    if (rc == 0)
-        rc = plot(o, runs, nruns, ref, err, sizeof err);
-    if (rc != 0) {
-        fprintf(stderr, "clothsim sweep: %s\n", err);
-        return CS_EXIT_OUTPUT;
-    }
-    return -1;
 }
 
 int cs_sweep_main(int argc, char **argv)
@@ -769,16 +668,16 @@ int cs_sweep_main(int argc, char **argv)
     if (status < 0)
         status = execute(&o, runs, nruns, ref);
     if (status < 0)
-        status = measure_runs(runs, nruns, ref, scene);
+        status = measure_runs(&o, runs, nruns, ref, scene);
     if (status < 0)
-        status = report(&o, runs, nruns, ref);
+        status = cs_sweep_report(&o, runs, nruns, ref);
     if (status < 0) {
         status = CS_EXIT_OK;
         for (int i = 0; i < nruns; i++)
             if (runs[i].exit != CS_EXIT_OK)
                 status = CS_EXIT_UNSTABLE;
-        printf("%d run%s in %s: sweep.csv, sweep.md, sweep.png\n", nruns, nruns == 1 ? "" : "s",
-               o.out_dir);
+        printf("%d run%s in %s: sweep.csv, sweep.md, sweep.png, %scumulative_time.png\n", nruns,
+               nruns == 1 ? "" : "s", o.out_dir, o.analytic ? "trajectory.png, " : "");
     }
     if (scene)
         cs_scene_destroy(scene);

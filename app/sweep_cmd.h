@@ -13,19 +13,35 @@ int cs_sweep_main(int argc, char **argv);
 
 void cs_sweep_help(FILE *out);
 
-/* One curve of sweep.png: a knob's runs (the other knobs at the
- * reference's values), seconds and error both > 0. */
+/* One curve of a sweep picture: n points (x[i], y[i]); on a log axis the
+ * points with a coordinate <= 0 are left out. */
 typedef struct cs_sweep_curve {
-    const char *label;
+    const char *label;  /* in the legend; NULL: not listed */
     int n;
-    double *seconds, *error;
+    const double *x, *y;
+    int colour;         /* 0: the palette's next; -1: black */
+    int style;          /* PLplot line style (2: dashed); 0: solid, dashed
+                           once the palette's 8 colours have run out */
+    double width;       /* line width; 0: 1 */
+    bool points;        /* a filled circle at each point */
 } cs_sweep_curve;
 
-/* Draws sweep.png into path with PLplot (pngcairo): error against wall
- * seconds, log-log, a curve per knob, the reference's seconds marked (when
- * > 0). Returns 0, or -1 with err (sweep_plot.c). */
-int cs_sweep_plot(const char *path, const cs_sweep_curve *curves, int ncurves,
-                  double ref_seconds, char *err, size_t errlen);
+/* A picture: curves on linear or log axes with a legend. */
+typedef struct cs_sweep_figure {
+    const char *title, *xlabel, *ylabel;
+    bool log_x, log_y;
+    const cs_sweep_curve *curves;
+    int ncurves;
+    double mark_x;          /* > 0: a dashed vertical line at x = mark_x ... */
+    const char *mark_label; /* ... labelled at its foot (NULL: none) */
+    int legend;             /* where: PL_POSITION_TOP | PL_POSITION_RIGHT, ...;
+                               another corner when the curves are there */
+} cs_sweep_figure;
+
+/* Draws the figure into path with PLplot (pngcairo, 900 x 640), written
+ * atomically. The one plotting helper of sweep.png, trajectory.png and
+ * cumulative_time.png. Returns 0, or -1 with err (sweep_plot.c). */
+int cs_sweep_plot(const char *path, const cs_sweep_figure *figure, char *err, size_t errlen);
 
 /* A table of text cells (row-major; "" not applicable), written atomically
  * as CSV (fields with commas quoted) or as a Markdown table ("" shown as

@@ -82,8 +82,15 @@ int cs_sweep_read_counts(const char *dir, cs_sweep_counts *c, char *err, size_t 
     }
     snprintf(c->status, sizeof c->status, "%s", status->valuestring);
     c->frames_written = (int)num(root, "frames_written", 0);
+    c->seconds = malloc(((size_t)cJSON_GetArraySize(frames) + 1) * sizeof *c->seconds);
+    if (!c->seconds) {
+        snprintf(err, errlen, "out of memory");
+        cJSON_Delete(root);
+        return -1;
+    }
     const cJSON *f;
     cJSON_ArrayForEach(f, frames) {
+        c->seconds[c->nseconds++] = num(f, "seconds", NAN);
         c->steps += (long)num(f, "steps", 0);
         c->cg_iterations += (long)num(f, "cg_iterations", 0);
         c->collisions += (long)num(f, "collisions", 0);
@@ -96,6 +103,80 @@ int cs_sweep_read_counts(const char *dir, cs_sweep_counts *c, char *err, size_t 
             c->penetration = pen;
     }
     cJSON_Delete(root);
+    return 0;
+}
+
+void cs_sweep_counts_free(cs_sweep_counts *c)
+{
+    free(c->seconds);
+    c->seconds = NULL;
+    c->nseconds = 0;
+}
+
+/* ---------------------------------------------------------------- analytic */
+
+static double dot3(const double *a, const double *b)
+{
+    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+}
+
+int cs_sweep_analytic_init(const cs_sim_def *def, cs_sweep_analytic *an, char *err,
+                           size_t errlen)
+{
+    memset(an, 0, sizeof *an);
+    const cs_body_def *plane = NULL;
+    int nplanes = 0;
+    for (int b = 0; b < def->nbodies; b++)
+        if (def->bodies[b].shape == CS_BODY_PLANE && !def->bodies[b].phi_fn)
+            plane = &def->bodies[b], nplanes++;
+    if (nplanes != 1 || !def->bodies_enabled) {
+        snprintf(err, errlen, "--analytic incline needs the scene to have one plane body "
+                              "(it has %d) and body collisions on", nplanes);
+        return -1;
+    }
+    if (plane->nfriction_keys > 0) {
+        snprintf(err, errlen, "--analytic incline needs a constant friction (body %s has a "
+                              "schedule)", plane->name ? plane->name : "0");
+        return -1;
+    }
+    double origin[3] = {0, 0, 0}, n[3];
+    cs_body_def_phi(plane, 0, origin, n); /* a plane's gradient: its normal */
+    double g = sqrt(dot3(def->gravity, def->gravity)), gn = dot3(def->gravity, n);
+    if (!(g > 0) || !(gn < 0) || def->ncloths < 1 || !(def->fps > 0)) {
+        snprintf(err, errlen, "--analytic incline needs a cloth, frames per second, and "
+                              "gravity pressing the cloth onto the plane");
+        return -1;
+    }
+    const double *v = def->cloths[0].velocity;
+    for (int c = 1; c < def->ncloths; c++)
+        if (memcmp(def->cloths[c].velocity, v, sizeof def->cloths[c].velocity) != 0) {
+            snprintf(err, errlen, "--analytic incline needs every cloth to start at the same "
+                                  "velocity (a rigid body)");
+            return -1;
+        }
+    double gt[3], vt[3], vn = dot3(v, n);
+    for (int k = 0; k < 3; k++) {
+        gt[k] = def->gravity[k] - gn * n[k];
+        vt[k] = v[k] - vn * n[k];
+    }
+    double gtl = sqrt(dot3(gt, gt)), vtl = sqrt(dot3(vt, vt));
+    /* downhill; on a level plane the way the cloth starts to slide */
+    const double *dir = gtl > 1e-12 * g ? gt : vtl > 0 ? vt : NULL;
+    double len = gtl > 1e-12 * g ? gtl : vtl;
+    if (dir) {
+        for (int k = 0; k < 3; k++)
+            an->down[k] = dir[k] / len;
+    } else { /* level and at rest: it stays; any direction in the plane */
+        double e[3] = {fabs(n[0]) < 0.9 ? 1 : 0, fabs(n[0]) < 0.9 ? 0 : 1, 0};
+        double en = dot3(e, n), l = 0;
+        for (int k = 0; k < 3; k++)
+            an->down[k] = e[k] - en * n[k], l += an->down[k] * an->down[k];
+        for (int k = 0; k < 3; k++)
+            an->down[k] /= sqrt(l);
+    }
+    an->motion = (cs_incline){g, gtl > 1e-12 * g ? gtl / g : 0, -gn / g, plane->friction,
+                              dot3(vt, an->down)};
+    an->fps = def->fps;
     return 0;
 }
 
@@ -423,7 +504,8 @@ static double one_sided(const surface *a, const tri_grid *b)
 
 double cs_sweep_error_headline(const cs_sweep_error *e)
 {
-    return isnan(e->vertex_max) ? e->hausdorff : e->vertex_max;
+    return !isnan(e->analytic) ? e->analytic : isnan(e->vertex_max) ? e->hausdorff
+                                                                     : e->vertex_max;
 }
 
 static int frame_error(const surface *a, const surface *ref, cs_sweep_error *e)
@@ -471,14 +553,33 @@ static void csv_num(FILE *out, double v, const char *sep)
         fprintf(out, "%.9g%s", v, sep);
 }
 
+/* The run's centre of mass at frame f against the analytic body's, which
+ * starts at the run's frame 0 (c0): the error, and the distances travelled
+ * downhill by both. */
+static void analytic_frame(const cs_sweep_analytic *an, const double c0[3], const surface *a,
+                           int f, double *error, double *travel, double *exact)
+{
+    double c[3], v, d[3];
+    centroid(a, c);
+    cs_incline_motion(&an->motion, f / an->fps, exact, &v);
+    for (int k = 0; k < 3; k++)
+        d[k] = c[k] - (c0[k] + *exact * an->down[k]);
+    *error = sqrt(dot3(d, d));
+    for (int k = 0; k < 3; k++)
+        d[k] = c[k] - c0[k];
+    *travel = dot3(d, an->down);
+}
+
 int cs_sweep_compare(const cs_frame_layout *layout, const char *dir, const char *ref_dir,
-                     int frames, FILE *per_frame, cs_sweep_error *overall, char *err,
-                     size_t errlen)
+                     int frames, const cs_sweep_analytic *an, FILE *per_frame, double *travel,
+                     cs_sweep_error *overall, char *err, size_t errlen)
 {
     overall->vertex_rms = overall->vertex_max = overall->com = overall->bbox =
-        overall->hausdorff = NAN;
+        overall->hausdorff = overall->analytic = NAN;
     if (per_frame)
-        fputs("frame,vertex_rms_m,vertex_max_m,com_m,bbox_m,hausdorff_m\n", per_frame);
+        fprintf(per_frame, "frame,vertex_rms_m,vertex_max_m,com_m,bbox_m,hausdorff_m%s\n",
+                an ? ",analytic_m,travel_m,travel_analytic_m" : "");
+    double c0[3] = {0, 0, 0};
     for (int f = 0; f < frames; f++) {
         surface a, ref;
         int status = surface_read(layout, dir, f, &a, err, errlen);
@@ -490,6 +591,14 @@ int cs_sweep_compare(const cs_frame_layout *layout, const char *dir, const char 
         }
         cs_sweep_error e;
         int rc = frame_error(&a, &ref, &e);
+        double moved = NAN, exact = NAN;
+        e.analytic = NAN;
+        if (an && f == 0)
+            centroid(&a, c0);
+        if (an)
+            analytic_frame(an, c0, &a, f, &e.analytic, &moved, &exact);
+        if (travel)
+            travel[f] = moved;
         surface_free(&a);
         surface_free(&ref);
         if (rc != 0) {
@@ -501,13 +610,19 @@ int cs_sweep_compare(const cs_frame_layout *layout, const char *dir, const char 
         overall->com = worse(overall->com, e.com);
         overall->bbox = worse(overall->bbox, e.bbox);
         overall->hausdorff = worse(overall->hausdorff, e.hausdorff);
+        overall->analytic = worse(overall->analytic, e.analytic);
         if (per_frame) {
             fprintf(per_frame, "%d,", f);
             csv_num(per_frame, e.vertex_rms, ",");
             csv_num(per_frame, e.vertex_max, ",");
             csv_num(per_frame, e.com, ",");
             csv_num(per_frame, e.bbox, ",");
-            csv_num(per_frame, e.hausdorff, "\n");
+            csv_num(per_frame, e.hausdorff, an ? "," : "\n");
+            if (an) {
+                csv_num(per_frame, e.analytic, ",");
+                csv_num(per_frame, moved, ",");
+                csv_num(per_frame, exact, "\n");
+            }
         }
     }
     return CS_EXIT_OK;

@@ -14,6 +14,9 @@
  * is measured from the smallest rank count r0 as r0 * S(r0) / S(N), so it
  * is the usual S(1) / S(N) whenever 1 rank was measured.
  *
+ * Drawn with PLplot's pngcairo device (plplot-driver-cairo), as clothsim
+ * sweep's pictures.
+ *
  * exit status: 0 written; 1 bad command line; 2 bad input (message
  * FILE:LINE: what was expected); 4 the picture could not be written.
  */
@@ -24,7 +27,8 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "bench/plot.h"
+#include <plplot.h>
+#include <stdbool.h>
 
 typedef struct sample {
     int ranks;
@@ -160,81 +164,140 @@ static int by_ranks(const void *a, const void *b)
     return (x > y) - (x < y);
 }
 
-enum { W = 1100, H = 520, PANEL_W = 420, TOP = 85, BOTTOM = H - 75 };
+/* PLplot calls this instead of exit() on an error it cannot go on from. */
+static int plplot_exit(const char *message)
+{
+    fprintf(stderr, "bench_scaling_plot: PLplot: %s\n", message);
+    return 1;
+}
+
+static bool have_pngcairo(void)
+{
+    PLCHAR_VECTOR menus[128], devs[128], *pm = menus, *pd = devs;
+    int ndevs = 128;
+    plgDevs(&pm, &pd, &ndevs);
+    for (int i = 0; i < ndevs; i++)
+        if (strcmp(devs[i], "pngcairo") == 0)
+            return true;
+    return false;
+}
+
+enum { BLACK = 15, GREY = 7, BLUE = 9 };
+
+/* One panel: the ideal line (dashed grey), the measured points joined
+ * (blue), each labelled (above or below the point), and a legend. */
+static void panel(double left, double right, double xmax, double ymax, const char *ylabel,
+                  const char *title, int n,
+                  const double *x, const double *y, const double ideal_x[2],
+                  const double ideal_y[2], const char *ideal_label, char (*text)[32],
+                  bool labels_below, PLINT legend_position)
+{
+    plcol0(BLACK);
+    plvpor(left, right, 0.12, 0.80);
+    plwind(0, xmax, 0, ymax);
+    plbox("bcnst", xmax <= 12 ? 1 : 0, 0, "bcnstv", 0, 0); /* whole ranks when few */
+    pllab("MPI ranks (processes)", ylabel, title);
+    plcol0(GREY);
+    pllsty(2);
+    plline(2, ideal_x, ideal_y);
+    pllsty(1);
+    plcol0(BLUE);
+    plwidth(2);
+    if (n > 1)
+        plline(n, x, y);
+    plwidth(1);
+    plstring(n, x, y, "#(728)");
+    plcol0(BLACK);
+    for (int i = 0; i < n; i++) /* dy in character heights as a fraction of the range */
+        plptex(x[i], y[i] + (labels_below ? -0.07 : 0.05) * ymax, 1, 0, 0.5, text[i]);
+    PLINT opts[2] = {PL_LEGEND_LINE, PL_LEGEND_LINE | PL_LEGEND_SYMBOL};
+    PLINT cols[2] = {GREY, BLUE}, styles[2] = {2, 1}, nsym[2] = {1, 1};
+    PLFLT widths[2] = {1, 2}, scales[2] = {1, 1};
+    const char *syms[2] = {"#(728)", "#(728)"}, *labels[2] = {ideal_label, "measured"};
+    PLFLT lw, lh;
+    pllegend(&lw, &lh, PL_LEGEND_BACKGROUND | PL_LEGEND_BOUNDING_BOX,
+             legend_position | PL_POSITION_INSIDE, 0.03, 0.03, 0.08, 0, BLACK, 1, 0, 0, 2, opts,
+             1.0, 0.8, 2.0, 0.0, cols, labels, NULL, NULL, NULL, NULL, cols, styles, widths, cols,
+             scales, nsym, syms);
+}
 
 static int draw(const table *t, const char *out)
 {
     int n = t->n;
     double *ranks = malloc(4 * (size_t)n * sizeof *ranks);
-    char (*text)[2][32] = malloc((size_t)n * sizeof *text);
-    const char **labels = malloc(2 * (size_t)n * sizeof *labels);
-    cs_plot *p = cs_plot_create(W, H);
-    int rc = -1;
-    if (!ranks || !text || !labels || !p)
-        goto done;
+    char (*eff_text)[32] = malloc((size_t)n * sizeof *eff_text);
+    char (*sec_text)[32] = malloc((size_t)n * sizeof *sec_text);
+    if (!ranks || !eff_text || !sec_text) {
+        free(ranks), free(eff_text), free(sec_text);
+        return -1;
+    }
     double *speedup = ranks + n, *efficiency = ranks + 2 * n, *seconds = ranks + 3 * n;
     const sample *base = &t->rows[0];
-    double top_speedup = 0;
+    double top_speedup = 0, top_efficiency = 0;
     for (int i = 0; i < n; i++) {
         ranks[i] = t->rows[i].ranks;
         seconds[i] = t->rows[i].seconds;
         speedup[i] = base->ranks * base->seconds / seconds[i];
         efficiency[i] = 100 * speedup[i] / ranks[i];
         top_speedup = fmax(top_speedup, speedup[i]);
-        snprintf(text[i][0], sizeof text[i][0], "%.0f%%", efficiency[i]);
-        snprintf(text[i][1], sizeof text[i][1], "%.3g s", seconds[i]);
-        labels[i] = text[i][0];
-        labels[n + i] = text[i][1];
+        top_efficiency = fmax(top_efficiency, efficiency[i]);
+        snprintf(eff_text[i], sizeof eff_text[i], "%.0f%%", efficiency[i]);
+        snprintf(sec_text[i], sizeof sec_text[i], "%.3g s", seconds[i]);
     }
     double most = fmax(2, ranks[n - 1]);
     double ideal_x[] = {base->ranks, most}, ideal_speedup[] = {base->ranks, most},
            ideal_efficiency[] = {100, 100};
-    /* speedup labels below the line, where the ideal line is not;
-     * efficiency labels above it, where the falling line is not */
-    const cs_plot_style speedup_style = {{0.15, 0.40, 0.80}, 2, 0, 4.5, 1};
-    const cs_plot_style efficiency_style = {{0.15, 0.40, 0.80}, 2, 0, 4.5, 0};
-    const cs_plot_style ideal = {{0.45, 0.45, 0.45}, 1.5, 1, 0, 0};
-
-    cs_plot_text(p, 90, 30, 15, t->title ? t->title : "Strong scaling");
-    /* ranks in whole steps (no tick at 1.5 ranks); room on the right for
-     * the last point's label */
-    cs_plot_axis x = {CS_PLOT_LINEAR, 0, 1.1 * most, fmax(1, cs_plot_nice_step(most)),
-                      "MPI ranks (processes)", NULL};
-    char speedup_label[64];
+    char speedup_label[64], title[512];
     if (base->ranks == 1)
         snprintf(speedup_label, sizeof speedup_label, "speedup over 1 rank");
     else
         snprintf(speedup_label, sizeof speedup_label, "speedup (%d ranks taken as ideal)",
                  base->ranks);
-    cs_plot_axis y = {CS_PLOT_LINEAR, 0, fmax(most, ceil(top_speedup)), 0, speedup_label, NULL};
-    cs_plot_panel(p, 90, TOP, 90 + PANEL_W, BOTTOM, &x, &y,
-                  "Speedup (labels: parallel efficiency)");
-    cs_plot_legend_at(p, 90 + 25, TOP + 20);
-    cs_plot_series(p, 2, ideal_x, ideal_speedup, NULL, &ideal);
-    cs_plot_legend(p, "ideal: speedup = ranks", &ideal);
-    cs_plot_series(p, n, ranks, speedup, labels, &speedup_style);
-    cs_plot_legend(p, "measured", &speedup_style);
+    snprintf(title, sizeof title, "%s", t->title ? t->title : "Strong scaling");
 
-    double top_efficiency = 0;
-    for (int i = 0; i < n; i++)
-        top_efficiency = fmax(top_efficiency, efficiency[i]);
-    cs_plot_axis e = {CS_PLOT_LINEAR, 0, fmax(120, 20 * ceil(top_efficiency / 20 + 0.25)), 20,
-                      "parallel efficiency = speedup / ranks", "%g%%"};
-    int left = W - 80 - PANEL_W;
-    cs_plot_panel(p, left, TOP, left + PANEL_W, BOTTOM, &x, &e,
-                  "Parallel efficiency (labels: s / frame)");
-    cs_plot_legend_at(p, left + 25, BOTTOM - 40);
-    cs_plot_series(p, 2, ideal_x, ideal_efficiency, NULL, &ideal);
-    cs_plot_legend(p, "ideal: 100%", &ideal);
-    cs_plot_series(p, n, ranks, efficiency, labels + n, &efficiency_style);
-    cs_plot_legend(p, "measured", &efficiency_style);
-    rc = cs_plot_write_png(p, out);
-done:
-    cs_plot_destroy(p);
-    free(labels);
-    free(text);
-    free(ranks);
-    return rc;
+    plsexit(plplot_exit);
+    if (!have_pngcairo()) {
+        fprintf(stderr, "bench_scaling_plot: PLplot has no pngcairo device (install "
+                        "plplot-driver-cairo)\n");
+        free(ranks), free(eff_text), free(sec_text);
+        return -1;
+    }
+    FILE *probe = fopen(out, "wb"); /* PLplot would ask for another name */
+    if (!probe) {
+        fprintf(stderr, "bench_scaling_plot: cannot write %s: %s\n", out, strerror(errno));
+        free(ranks), free(eff_text), free(sec_text);
+        return -1;
+    }
+    fclose(probe);
+    plsdev("pngcairo");
+    plsfnam(out);
+    plspage(0, 0, 1200, 560, 0, 0);
+    plscolbg(255, 255, 255);
+    plscol0(BLACK, 0, 0, 0);
+    plscol0(GREY, 110, 110, 110);
+    plinit();
+    pladv(0);
+    /* speedup labels below the line, where the ideal line is not; efficiency
+     * labels above it, where the falling line is not */
+    panel(0.09, 0.46, 1.15 * most, fmax(most, ceil(top_speedup)) * 1.1, speedup_label,
+          "Speedup (labels: parallel efficiency)", n, ranks, speedup, ideal_x, ideal_speedup,
+          "ideal: speedup = ranks", eff_text, true, PL_POSITION_TOP | PL_POSITION_LEFT);
+    panel(0.60, 0.97, 1.15 * most, fmax(120, 20 * ceil(top_efficiency / 20 + 0.25)),
+          "parallel efficiency = speedup / ranks, %", "Parallel efficiency (labels: s / frame)",
+          n, ranks, efficiency, ideal_x, ideal_efficiency, "ideal: 100%", sec_text, false,
+          PL_POSITION_BOTTOM | PL_POSITION_LEFT);
+    /* the overall title above both panels */
+    plvpor(0, 1, 0, 1);
+    plwind(0, 1, 0, 1);
+    plcol0(BLACK);
+    plptex(0.5, 0.95, 1, 0, 0.5, title);
+    plend();
+    free(ranks), free(eff_text), free(sec_text);
+    FILE *f = fopen(out, "rb"); /* PLplot reports no write error of its own */
+    if (!f)
+        return -1;
+    fclose(f);
+    return 0;
 }
 
 int main(int argc, char **argv)

@@ -1,11 +1,12 @@
 /* incline_analytic.h: runs an incline validation scene (scenes/validation)
  * at a chosen angle, friction and initial speed, through the same --set
  * overrides a user types, and measures it against the analytic solution.
- * Shared by tests/test_incline.c and bench/accuracy_time.c.
+ * Used by tests/test_incline.c.
  *
- * Analytic: a = (sin theta - mu cos theta) g along the slope,
- * x(t) = v0 t + a t^2 / 2 and v(t) = v0 + a t until v reaches 0 (when
- * mu > tan theta), then at rest. */
+ * Analytic: cs_incline_motion (common/incline.h, the one definition, which
+ * `clothsim sweep --analytic incline` uses too): a = (sin theta - mu cos
+ * theta) g along the slope, x(t) = v0 t + a t^2 / 2 and v(t) = v0 + a t
+ * until v reaches 0 (when mu > tan theta), then at rest. */
 #ifndef CS_INCLINE_ANALYTIC_H
 #define CS_INCLINE_ANALYTIC_H
 
@@ -14,6 +15,7 @@
 #include <string.h>
 #include <time.h>
 
+#include "common/incline.h"
 #include "import/import.h"
 
 #define G 9.8
@@ -28,13 +30,6 @@ typedef struct incline_result {
     double seconds;         /* wall time of the simulation */
     long cg_iterations;
 } incline_result;
-
-static double analytic_time(double v0, double a, double t)
-{
-    if (a < 0 && t > -v0 / a)
-        return -v0 / a; /* stopped */
-    return t;
-}
 
 /* extra: further overrides (e.g. "time.dt=1e-3"), may be NULL. Returns 0,
  * or -1 with err filled. */
@@ -76,7 +71,7 @@ static int run_incline(const char *scene_file, double theta_deg, double mu, doub
     for (int d = 0; d < 3; d++)
         com0[d] /= total;
 
-    double a = (sin(th) - mu * cos(th)) * G;
+    cs_incline motion = cs_incline_make(G, theta_deg, mu, v0);
     incline_result res = {.stop_time = -1};
     double s_prev = 0, t_prev = 0;
     for (int f = 1; f <= scene->frames; f++) {
@@ -94,9 +89,8 @@ static int run_incline(const char *scene_file, double theta_deg, double mu, doub
                 s += mass[i] * (cs_sim_positions(sim)[3 * i + d] - com0[d]) * down[d] / total;
                 vs += mass[i] * cs_sim_velocities(sim)[3 * i + d] * down[d] / total;
             }
-        double ts = analytic_time(v0, a, t);
-        double exact = v0 * ts + 0.5 * a * ts * ts;
-        double v_exact = v0 + a * ts;
+        double exact, v_exact;
+        cs_incline_motion(&motion, t, &exact, &v_exact);
         /* 1e-3 of the distance travelled, or 1e-4 m where that is smaller */
         double tol_x = fmax(1e-3 * fabs(exact), 1e-4);
         double tol_v = fmax(1e-3 * fabs(v_exact), 1e-3);
