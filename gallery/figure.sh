@@ -32,8 +32,9 @@
 #   NAME.png (last frame), NAME_fNNNN.png (key frames, but those the same
 #   picture as the last: the cloth at rest), NAME_preview.png,
 #   NAME_turntable.png (contact sheet), NAME.gif (the animation when under
-#   5 MB, else animation_320.gif, the same 320 pixels wide, if that is),
-#   NAME_compare.png (or NAME_compare_a.png and _b.png).
+#   FIGURE_GIF_MAX, else animation_small.gif, the same 320 pixels wide at 12
+#   frames a second, if that is), NAME_compare.png (or NAME_compare_a.png
+#   and _b.png).
 #
 # What the scene's header comment may say, one line each:
 #   # gallery: --set cloths.0.grid.resolution=[224,224]
@@ -43,16 +44,24 @@
 #         "GALLERY size" note) is used, else none.
 #   # keyframes: 12,24,36
 #         the stills besides the last frame (default: a quarter, half and
-#         three quarters of the run); numbers past the last frame are dropped
+#         three quarters of the run); numbers past the last frame are dropped,
+#         and `none` asks for none
 #   # compare: --set effects.friction=projection
 #         a second run with these options, shown beside the first
 #         (rolling_cloth compares with the previous friction method, Fig. 7,
-#         even without the line)
+#         even without the line); a first word frame=N compares frame N of
+#         the two runs instead of their last frames (e.g. where both are still
+#         in view), as FIGURE_COMPARE_FRAME=N does
 #
-# Environment: BUILD (default build, a Release build), FIGURE_RUN_ARGS (more
+# Environment: BUILD (default build, a Release build), FIGURE_SIM_ONLY=1
+# (the run and its Table 3 row, no pictures, nothing copied), FIGURE_RUN_ARGS (more
 # `clothsim run` options, e.g. "--frames 12" while developing),
 # FIGURE_STILL_SIZE/_SAMPLES, FIGURE_ANIM_SIZE/_SAMPLES (image size and
-# samples of the stills and of the animation).
+# samples of the stills and of the animation), FIGURE_RENDER_ARGS (more
+# options of the ray-traced renders, e.g. "--threads 1"), FIGURE_GIF_MAX
+# (bytes, default 1500000: a larger animation.gif is copied as
+# animation_small.gif, 320 pixels wide at 12 frames a second, if that is
+# under it).
 # Exit status: 0 done; 1 bad command line; else the failing command's.
 set -eu
 set -f   # options such as resolution=[224,224] are never file patterns
@@ -153,11 +162,19 @@ if gallery is None:
     gallery = fallback or ""
 if compare is None and name == "rolling_cloth":
     compare = "--set effects.friction=projection"
+compare_frame = ""
+if compare:
+    m = re.match(r"frame=(\d+)\s*(.*)$", compare)
+    if m:
+        compare_frame, compare = m.group(1), m.group(2).strip()
 for var, value in (("GALLERY_ARGS", gallery), ("KEYFRAMES", keyframes or ""),
-                   ("COMPARE_ARGS", compare or "")):
+                   ("COMPARE_ARGS", compare or ""), ("COMPARE_FRAME", compare_frame)):
     print("%s=%s" % (var, shlex.quote(value)))
 EOF
 )"
+COMPARE_FRAME=${FIGURE_COMPARE_FRAME:-$COMPARE_FRAME}
+RARGS=${FIGURE_RENDER_ARGS:-}
+GIF_MAX=${FIGURE_GIF_MAX:-1500000}
 SIZE_ARGS=
 [ "$MODE" = gallery ] && SIZE_ARGS=$GALLERY_ARGS
 echo "figure $NAME ($MODE): $SCENE ${SIZE_ARGS:+with $SIZE_ARGS}"
@@ -193,6 +210,8 @@ simulate "$OUT/run" $SIZE_ARGS ${FIGURE_RUN_ARGS:-} || {
 }
 tail -n 3 "$OUT/run.log"
 
+# FIGURE_SIM_ONLY=1: the run and its Table 3 row only (no pictures)
+if [ -z "${FIGURE_SIM_ONLY:-}" ]; then
 # The last frame, the key frames and whether to draw the mesh's edges.
 eval "$(python3 - "$OUT/run/summary.json" "$KEYFRAMES" <<'EOF'
 import json, sys
@@ -216,19 +235,22 @@ for k in $KEYS; do LIST="$LIST$k,"; done
 LIST=${LIST}last
 LASTF=$(printf '%04d' "$LAST")
 
+# shellcheck disable=SC2086
 step "$EXE" render "$OUT/run" -q --frames "$LIST" --size "$STILL_SIZE" \
-    --samples "$STILL_SAMPLES" -o "$OUT/stills"
+    --samples "$STILL_SAMPLES" $RARGS -o "$OUT/stills"
 WIRE=
 [ "$TRIANGLES" -le 20000 ] && WIRE=--wireframe
 step "$EXE" render "$OUT/run" -q --engine preview $WIRE --frames last --size "$STILL_SIZE" \
     --samples 8 -o "$OUT/preview"
 # A turntable can fail where the scene cannot be seen all round (an orbiting
 # camera below an inclined plane is refused): said, and left out.
+# shellcheck disable=SC2086
 step "$EXE" render "$OUT/run" -q --frames last --turntable 8 --size "$TURN_SIZE" \
-    --samples "$TURN_SAMPLES" -o "$OUT/turntable" ||
+    --samples "$TURN_SAMPLES" $RARGS -o "$OUT/turntable" ||
     echo "figure.sh: no turntable for $NAME (above); going on without it" >&2
+# shellcheck disable=SC2086
 step "$EXE" render "$OUT/run" -q --animation --size "$ANIM_SIZE" --samples "$ANIM_SAMPLES" \
-    -o "$OUT/animation"
+    $RARGS -o "$OUT/animation"
 
 # A comparison: the same scene with other settings, the last frames side by
 # side (left: the scene as written; right: with COMPARE_ARGS).
@@ -246,8 +268,21 @@ if [ -n "$COMPARE_ARGS" ]; then
     # an unstable comparison (exit 3) kept the frames before; show its last
     [ "$crc" -eq 3 ] && echo "figure.sh: the comparison run became unstable:" \
         "$(tail -n 1 "$OUT/compare.log")" >&2
-    step "$EXE" render "$OUT/compare" -q --frames last --size "$STILL_SIZE" \
-        --samples "$STILL_SAMPLES" -o "$OUT/compare_stills"
+    # the frame compared: the last of each run, or frame=N of both
+    CFRAMES=last
+    ASTILL=$OUT/stills/frame_$LASTF.png
+    ATEXT=
+    if [ -n "$COMPARE_FRAME" ]; then
+        CFRAMES=$COMPARE_FRAME
+        ATEXT=", frame $COMPARE_FRAME"
+        # shellcheck disable=SC2086
+        step "$EXE" render "$OUT/run" -q --frames "$CFRAMES" --size "$STILL_SIZE" \
+            --samples "$STILL_SAMPLES" $RARGS -o "$OUT/compare_ours"
+        ASTILL=$OUT/compare_ours/frame_$(printf '%04d' "$COMPARE_FRAME").png
+    fi
+    # shellcheck disable=SC2086
+    step "$EXE" render "$OUT/compare" -q --frames "$CFRAMES" --size "$STILL_SIZE" \
+        --samples "$STILL_SAMPLES" $RARGS -o "$OUT/compare_stills"
     set +f
     CSTILL=$(ls "$OUT"/compare_stills/frame_*.png | tail -n 1)
     set -f
@@ -260,17 +295,19 @@ if [ -n "$COMPARE_ARGS" ]; then
             printf "drawtext=fontfile=%s:text='%s':x=24:y=24:fontsize=36:fontcolor=white:%s" \
                 "$FONT" "$1" "box=1:boxcolor=black@0.5:boxborderw=8"
         }
-        FILTER="[0:v]$(label 'as written')[a];[1:v]$(label "$right")[b];[a][b]hstack=inputs=2"
+        FILTER="[0:v]$(label "as written$ATEXT")[a];[1:v]$(label "$right$ATEXT")[b];[a][b]hstack=inputs=2"
         [ -f "$FONT" ] || FILTER="[0:v][1:v]hstack=inputs=2"
-        step ffmpeg -nostdin -v error -y -i "$OUT/stills/frame_$LASTF.png" -i "$CSTILL" \
+        step ffmpeg -nostdin -v error -y -i "$ASTILL" -i "$CSTILL" \
             -filter_complex "$FILTER" "$OUT/side_by_side.png" ||
-            step ffmpeg -nostdin -v error -y -i "$OUT/stills/frame_$LASTF.png" -i "$CSTILL" \
+            step ffmpeg -nostdin -v error -y -i "$ASTILL" -i "$CSTILL" \
                 -filter_complex "[0:v][1:v]hstack=inputs=2" "$OUT/side_by_side.png"
     else
-        echo "figure.sh: ffmpeg is not installed: the two stills are $OUT/stills/frame_$LASTF.png" \
+        echo "figure.sh: ffmpeg is not installed: the two stills are $ASTILL" \
             "and $CSTILL (no side-by-side picture)" >&2
     fi
 fi
+
+fi # FIGURE_SIM_ONLY
 
 # Table 3's row.
 python3 - "$OUT" "$NAME" "$MODE" "$SCENE" "$EXE" <<'EOF'
@@ -326,7 +363,7 @@ with open(os.path.join(out, "table3.md"), "w") as f:
 print("table 3: " + md.strip())
 EOF
 
-if [ -n "$COPY" ]; then
+if [ -n "$COPY" ] && [ -z "${FIGURE_SIM_ONLY:-}" ]; then
     G=gallery/figures
     mkdir -p "$G"
     set +f
@@ -345,26 +382,27 @@ if [ -n "$COPY" ]; then
     if [ -f "$OUT/turntable/contact_sheet.png" ]; then
         step cp "$OUT/turntable/contact_sheet.png" "$G/${NAME}_turntable.png"
     fi
-    # The GIF when under 5 MB; else one 320 pixels wide made from it.
+    # The GIF when under GIF_MAX bytes; else one 320 pixels wide at 12
+    # frames a second made from it.
     GIF=$OUT/animation/animation.gif
-    if [ -f "$GIF" ] && [ "$(wc -c <"$GIF")" -ge 5000000 ]; then
+    if [ -f "$GIF" ] && [ "$(wc -c <"$GIF")" -ge "$GIF_MAX" ]; then
         step ffmpeg -nostdin -v error -y -i "$GIF" \
-            -vf "scale=320:-2:flags=lanczos,split[a][b];[a]palettegen[p];[b][p]paletteuse" \
-            "$OUT/animation/animation_320.gif" || true
-        GIF=$OUT/animation/animation_320.gif
+            -vf "fps=12,scale=320:-2:flags=lanczos,split[a][b];[a]palettegen[p];[b][p]paletteuse" \
+            "$OUT/animation/animation_small.gif" || true
+        GIF=$OUT/animation/animation_small.gif
     fi
     if [ -f "$GIF" ]; then
         bytes=$(wc -c <"$GIF")
-        if [ "$bytes" -lt 5000000 ]; then
+        if [ "$bytes" -lt "$GIF_MAX" ]; then
             step cp "$GIF" "$G/$NAME.gif"
         else
-            echo "figure.sh: $GIF is $bytes bytes, not copied (5 MB at most)"
+            echo "figure.sh: $GIF is $bytes bytes, not copied ($GIF_MAX at most)"
         fi
     fi
     if [ -f "$OUT/side_by_side.png" ]; then
         step cp "$OUT/side_by_side.png" "$G/${NAME}_compare.png"
     elif [ -n "$COMPARE_ARGS" ]; then
-        step cp "$OUT/stills/frame_$LASTF.png" "$G/${NAME}_compare_a.png"
+        step cp "$ASTILL" "$G/${NAME}_compare_a.png"
         step cp "$CSTILL" "$G/${NAME}_compare_b.png"
     fi
 fi
