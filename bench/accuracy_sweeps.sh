@@ -15,6 +15,8 @@
 #   repulsion        stack: self_collision.thickness x self_collision.stiffness
 #   zone_iterations  stack: self_collision.zone_iterations
 #   scheme           stack: self_collision.scheme=fixed,rewind: Fig. 14
+#   twist            the twisting cloth (scenes/figures/twist.yaml, Fig. 3):
+#                    time.collision_steps under high tension
 #
 # Each sweep runs into out/accuracy/NAME/ with --repeat $REPEAT (default 3:
 # every run three times, its wall_s the median), and its tables and pictures
@@ -32,7 +34,7 @@ export OMP_NUM_THREADS="${THREADS:-1}"
 OUT=out/accuracy
 GALLERY=gallery/accuracy
 ALL="friction_acc friction_dec cg_tolerance collision_steps zone_iterations scheme repulsion
-dt_safety resolution incline"
+dt_safety resolution incline twist"
 # shellcheck disable=SC2086 # $ALL is a list
 [ $# -gt 0 ] || set -- $ALL
 
@@ -128,6 +130,9 @@ for name in "$@"; do
         ;;
     zone_iterations)
         sweep zone_iterations $STACK --vary self_collision.zone_iterations=1,2,4,8,16
+        ;;
+    twist)
+        sweep twist scenes/figures/twist.yaml --vary time.collision_steps=1,4,16
         ;;
     scheme)
         sweep scheme $STACK --vary self_collision.scheme=fixed,rewind \
