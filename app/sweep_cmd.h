@@ -43,6 +43,10 @@ typedef struct cs_sweep_figure {
  * cumulative_time.png. Returns 0, or -1 with err (sweep_plot.c). */
 int cs_sweep_plot(const char *path, const cs_sweep_figure *figure, char *err, size_t errlen);
 
+/* Whether PLplot has its pngcairo device (without it, PLplot would ask for
+ * a device on the terminal); also bench/scaling_plot.c's check. */
+bool cs_plot_has_pngcairo(void);
+
 /* A table of text cells (row-major; "" not applicable), written atomically
  * as CSV (fields with commas quoted) or as a Markdown table ("" shown as
  * "–"). Returns 0, or -1 with err (sweep_report.c). */

@@ -59,7 +59,7 @@ static void curve_pen(const cs_sweep_figure *f, int c, PLINT *colour, PLINT *sty
     *style = f->curves[c].style > 0 ? f->curves[c].style : 1 + (k / NPALETTE) % 8;
 }
 
-static bool have_pngcairo(void)
+bool cs_plot_has_pngcairo(void)
 {
     PLCHAR_VECTOR menus[128], devs[128], *pm = menus, *pd = devs;
     int ndevs = 128;
@@ -179,7 +179,7 @@ static int fill_plot(const char *tmp, void *ctx, char *why, size_t whylen)
     axis_range(&ymin, &ymax, f->log_y);
 
     plsexit(plplot_exit);
-    if (!have_pngcairo()) { /* PLplot would ask on the terminal */
+    if (!cs_plot_has_pngcairo()) { /* PLplot would ask on the terminal */
         snprintf(why, whylen, "PLplot has no pngcairo device (install plplot-driver-cairo)");
         return -1;
     }

@@ -30,6 +30,8 @@
 #include <plplot.h>
 #include <stdbool.h>
 
+#include "app/sweep_cmd.h"
+
 typedef struct sample {
     int ranks;
     double seconds;
@@ -171,17 +173,6 @@ static int plplot_exit(const char *message)
     return 1;
 }
 
-static bool have_pngcairo(void)
-{
-    PLCHAR_VECTOR menus[128], devs[128], *pm = menus, *pd = devs;
-    int ndevs = 128;
-    plgDevs(&pm, &pd, &ndevs);
-    for (int i = 0; i < ndevs; i++)
-        if (strcmp(devs[i], "pngcairo") == 0)
-            return true;
-    return false;
-}
-
 enum { BLACK = 15, GREY = 7, BLUE = 9 };
 
 /* One panel: the ideal line (dashed grey), the measured points joined
@@ -256,7 +247,7 @@ static int draw(const table *t, const char *out)
     snprintf(title, sizeof title, "%s", t->title ? t->title : "Strong scaling");
 
     plsexit(plplot_exit);
-    if (!have_pngcairo()) {
+    if (!cs_plot_has_pngcairo()) {
         fprintf(stderr, "bench_scaling_plot: PLplot has no pngcairo device (install "
                         "plplot-driver-cairo)\n");
         free(ranks), free(eff_text), free(sec_text);

@@ -70,20 +70,23 @@ static void test_schedule_values(void **state)
 
 /* --------------------------------------------------------- the incline */
 
-/* The scene of scenes/validation/particle_accelerating.yaml and
- * tetrahedron_accelerating.yaml with the schedule instead of friction. */
+/* The scenes of scenes/validation/particle_accelerating.yaml and
+ * tetrahedron_accelerating.yaml with the schedule instead of friction: the
+ * 36 degree incline whose friction ramps from 0.9 down to 0.2. */
+#define RAMPED_INCLINE                                                                       \
+    "bodies:\n"                                                                              \
+    "  - shape: plane\n"                                                                     \
+    "    rotation: [0, 0, 36]\n"                                                             \
+    "    friction_keys:\n"                                                                   \
+    "      - {time: 0, friction: 0.9}\n"                                                     \
+    "      - {time: 0.3, friction: 0.9}\n"                                                   \
+    "      - {time: 0.4, friction: 0.2}\n"
+
 static const char *particle_scene =
     "time: {fps: 100, frames: 100, dt: 0.001}\n"
     "gravity: [0, -9.8, 0]\n"
     "cloths:\n"
-    "  - mesh: {vertices: [[0, 0, 0]]}\n"
-    "bodies:\n"
-    "  - shape: plane\n"
-    "    rotation: [0, 0, 36]\n"
-    "    friction_keys:\n"
-    "      - {time: 0, friction: 0.9}\n"
-    "      - {time: 0.3, friction: 0.9}\n"
-    "      - {time: 0.4, friction: 0.2}\n";
+    "  - mesh: {vertices: [[0, 0, 0]]}\n" RAMPED_INCLINE;
 
 static const char *tetrahedron_scene =
     "time: {fps: 100, frames: 100, cg_tolerance: 1e-9}\n"
@@ -95,14 +98,7 @@ static const char *tetrahedron_scene =
     "      triangles: [[0, 2, 1], [0, 1, 3], [1, 2, 3], [2, 0, 3]]\n"
     "      rotation: [0, 0, 36]\n"
     "    material: {edge_stiffness: 100, edge_overdamping: 1, bend_stiffness: 100,\n"
-    "               bend_overdamping: 1, node_mass: 0.001}\n"
-    "bodies:\n"
-    "  - shape: plane\n"
-    "    rotation: [0, 0, 36]\n"
-    "    friction_keys:\n"
-    "      - {time: 0, friction: 0.9}\n"
-    "      - {time: 0.3, friction: 0.9}\n"
-    "      - {time: 0.4, friction: 0.2}\n";
+    "               bend_overdamping: 1, node_mass: 0.001}\n" RAMPED_INCLINE;
 
 /* Distance down the slope at time t from rest at t = 0. */
 static double analytic_distance(double t)

@@ -227,17 +227,20 @@ static void run_scene(const char *name, const char *text, int noverrides,
     "    mesh: {vertices: [[-1, 0, -1], [1, 0, -1], [0, 0, 1]], triangles: [[0, 1, 2]]}\n" \
     "    pins: [{vertices: [0, 1, 2]}]\n"
 
+/* Eight frames without gravity: the floor, then a free "dart" triangle. */
+#define DART_OVER_FLOOR                                                                      \
+    "time: {fps: 50, frames: 8, dt: 2e-4}\n"                                                 \
+    "gravity: [0, 0, 0]\n"                                                                   \
+    "effects: {self_collision: true}\n"                                                      \
+    "cloths:\n" FLOOR_TRIANGLE "  - name: dart\n"
+
 static void test_point_on_triangle_moving_in_its_plane(void **state)
 {
     (void)state;
     /* the dart's tip lies exactly in the floor's plane, outside it, and
      * slides within that plane into the triangle: the coplanarity cubic
      * vanishes identically all the way */
-    const char *scene = "time: {fps: 50, frames: 8, dt: 2e-4}\n"
-                        "gravity: [0, 0, 0]\n"
-                        "effects: {self_collision: true}\n"
-                        "cloths:\n" FLOOR_TRIANGLE
-                        "  - name: dart\n"
+    const char *scene = DART_OVER_FLOOR
                         "    mesh: {vertices: [[0, 0, 1.05], [0.2, 0.1, 1.2], [-0.2, 0.1, 1.2]],\n"
                         "           triangles: [[0, 1, 2]]}\n"
                         "    velocity: [0, 0, -1]\n";
@@ -249,11 +252,7 @@ static void test_edge_through_an_endpoint(void **state)
     (void)state;
     /* the dart's edge (0)-(1) is vertical at z = 1 and sweeps along -x
      * exactly through the floor's vertex (0, 0, 1) at t = 0.08 s */
-    const char *scene = "time: {fps: 50, frames: 8, dt: 2e-4}\n"
-                        "gravity: [0, 0, 0]\n"
-                        "effects: {self_collision: true}\n"
-                        "cloths:\n" FLOOR_TRIANGLE
-                        "  - name: dart\n"
+    const char *scene = DART_OVER_FLOOR
                         "    mesh: {vertices: [[0.024, -0.1, 1], [0.024, 0.1, 1], [0.124, 0.1, 1.2]],\n"
                         "           triangles: [[0, 1, 2]]}\n"
                         "    velocity: [-0.3, 0, 0]\n";
