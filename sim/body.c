@@ -121,30 +121,22 @@ void cs_body_def_velocity(const cs_body_def *b, double t, const double x[3], dou
         v[i] = vel[i] + wr[i];
 }
 
-/* Piecewise linear between the keys, constant outside them. The loader
- * refuses unsorted times and negative values; a definition made in code is
- * read defensively (at most CS_BODY_MAX_FRICTION_KEYS keys, a key that
- * does not follow its predecessor taken as a step, never below 0). */
+/* Piecewise linear between the keys, constant outside them (the keys are
+ * sorted, at most CS_BODY_MAX_FRICTION_KEYS and >= 0: cs_sim_create's
+ * check). */
 double cs_body_def_friction(const cs_body_def *b, double t)
 {
     int n = b->nfriction_keys;
     if (n <= 0)
         return b->friction;
-    if (n > CS_BODY_MAX_FRICTION_KEYS)
-        n = CS_BODY_MAX_FRICTION_KEYS;
     const cs_friction_key *k = b->friction_keys;
-    double mu;
-    if (n == 1 || t <= k[0].time) {
-        mu = k[0].friction;
-    } else if (t >= k[n - 1].time) {
-        mu = k[n - 1].friction;
-    } else {
-        int i = 0;
-        while (i + 2 < n && k[i + 1].time <= t)
-            i++;
-        double span = k[i + 1].time - k[i].time;
-        mu = span > 0 ? k[i].friction + (t - k[i].time) / span * (k[i + 1].friction - k[i].friction)
-                      : k[i + 1].friction;
-    }
-    return mu > 0 ? mu : 0.0; /* NaN too */
+    if (t <= k[0].time)
+        return k[0].friction;
+    if (t >= k[n - 1].time)
+        return k[n - 1].friction;
+    int i = 0;
+    while (k[i + 1].time <= t)
+        i++;
+    return k[i].friction +
+           (t - k[i].time) / (k[i + 1].time - k[i].time) * (k[i + 1].friction - k[i].friction);
 }
