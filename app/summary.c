@@ -225,6 +225,8 @@ static cJSON *frame_json(const cs_summary *s, const cs_frame_record *f, builder 
         add_num(b, o, "impact_zones", (double)st->impact_zones);
         add_num(b, o, "max_zone_size", (double)st->max_zone_size);
         add_num(b, o, "rewinds", (double)st->rewinds);
+        add_num(b, o, "pair_searches", (double)st->pair_searches);
+        add_num(b, o, "pair_traversals", (double)st->pair_traversals);
     }
     if (st->intersections >= 0)
         add_num(b, o, "intersections", (double)st->intersections);

@@ -63,9 +63,8 @@ int cs_bvh_build(cs_bvh *t, int nprims, const cs_box *pb)
     t->count = calloc((size_t)cap, sizeof *t->count);
     t->order = calloc((size_t)nprims + 1, sizeof *t->order);
     t->leaf_box = calloc((size_t)nprims + 1, sizeof *t->leaf_box);
-    t->dirty = calloc((size_t)cap, 1);
     builder b = {t, pb, calloc(3 * (size_t)nprims + 3, sizeof(double)), 0};
-    if (!t->box || !t->child || !t->first || !t->count || !t->order || !t->dirty ||
+    if (!t->box || !t->child || !t->first || !t->count || !t->order ||
         !t->leaf_box || !b.centroid) {
         free(b.centroid);
         cs_bvh_free(t);
@@ -79,7 +78,7 @@ int cs_bvh_build(cs_bvh *t, int nprims, const cs_box *pb)
     if (nprims > 0)
         build_node(&b, 0, nprims);
     free(b.centroid);
-    cs_bvh_refit(t, pb, NULL);
+    cs_bvh_refit(t, pb);
     return 0;
 }
 
@@ -91,41 +90,36 @@ void cs_bvh_free(cs_bvh *t)
     free(t->count);
     free(t->order);
     free(t->leaf_box);
-    free(t->dirty);
     free(t->rank_lo);
     free(t->rank_hi);
     memset(t, 0, sizeof *t);
 }
 
-void cs_bvh_refit(cs_bvh *t, const cs_box *pb, const unsigned char *prim_dirty)
+void cs_bvh_refit(cs_bvh *t, const cs_box *pb)
 {
     for (int node = t->nnodes - 1; node >= 0; node--) {
         cs_box *b = t->box + node;
         int l = t->child[2 * node];
         if (l < 0) {
             cs_box_empty(b);
-            unsigned char dirty = 0;
             for (int k = t->first[node]; k < t->first[node] + t->count[node]; k++) {
                 int p = t->order[k];
                 t->leaf_box[k] = pb[p];
                 cs_box_add_point(b, pb[p].lo);
                 cs_box_add_point(b, pb[p].hi);
-                dirty |= prim_dirty ? prim_dirty[p] : 0;
             }
-            t->dirty[node] = dirty;
         } else {
             int r = t->child[2 * node + 1];
             *b = t->box[l];
             cs_box_add_point(b, t->box[r].lo);
             cs_box_add_point(b, t->box[r].hi);
-            t->dirty[node] = t->dirty[l] | t->dirty[r];
         }
     }
 }
 
 typedef struct traversal {
     const cs_bvh *A, *B;
-    bool self, only_dirty;
+    bool self;
     int rank;
     int depth;            /* planning: node pairs this deep become tasks */
     cs_bvh_work *plan;    /* planning: where the tasks go; NULL when traversing */
@@ -190,8 +184,6 @@ static bool planned(traversal *tr, int i, int j, int depth, bool leaves)
 static void descend(traversal *tr, int i, int j, int depth)
 {
     const cs_bvh *A = tr->A, *B = tr->B;
-    if (tr->only_dirty && !A->dirty[i] && !B->dirty[j])
-        return;
     if (tr->rank >= 0 && A->rank_lo && B->rank_lo) {
         /* every pair below goes to a rank in [lo, hi]: none is ours */
         int lo = A->rank_lo[i] < B->rank_lo[j] ? A->rank_lo[i] : B->rank_lo[j];
@@ -245,14 +237,14 @@ static void descend(traversal *tr, int i, int j, int depth)
  * so uneven ones even out. */
 enum { TASK_DEPTH = 8 };
 
-int cs_bvh_collect(const cs_bvh *A, const cs_bvh *B, bool only_dirty, int rank, cs_bvh_work *w,
+int cs_bvh_collect(const cs_bvh *A, const cs_bvh *B, int rank, cs_bvh_work *w,
                    cs_index_pairs *out)
 {
     out->n = 0;
     w->ntasks = 0;
     if (A->nnodes == 0 || B->nnodes == 0)
         return 0;
-    traversal plan = {A, B, A == B, only_dirty, rank, TASK_DEPTH, w, NULL, 0};
+    traversal plan = {A, B, A == B, rank, TASK_DEPTH, w, NULL, 0};
     descend(&plan, 0, 0, 0);
     if (plan.failed)
         return -1;
@@ -267,7 +259,7 @@ int cs_bvh_collect(const cs_bvh *A, const cs_bvh *B, bool only_dirty, int rank, 
     int failed = 0;
 #pragma omp parallel for schedule(dynamic, 1) reduction(| : failed)
     for (int t = 0; t < w->ntasks; t++) {
-        traversal tr = {A, B, A == B, only_dirty, rank, 0, NULL, w->found + t, 0};
+        traversal tr = {A, B, A == B, rank, 0, NULL, w->found + t, 0};
         tr.out->n = 0;
         descend(&tr, w->task[2 * t], w->task[2 * t + 1], 0);
         failed |= tr.failed;

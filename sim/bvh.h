@@ -3,8 +3,7 @@
  * The topology is built once from the primitives' boxes at creation (median
  * split of centroids along the widest axis); every use refits the boxes
  * bottom-up. Nodes are stored parents before children, so a reverse sweep
- * refits. A dirty flag per node lets repeated searches skip subtrees whose
- * primitives did not change. */
+ * refits. */
 #ifndef CS_BVH_H
 #define CS_BVH_H
 
@@ -22,14 +21,13 @@ typedef struct cs_bvh {
     int *first, *count;   /* leaf: primitives order[first .. first+count) */
     int *order;           /* primitive ids in leaf order */
     cs_box *leaf_box;     /* their boxes in leaf order, from the last refit */
-    unsigned char *dirty; /* per node, from cs_bvh_refit's dirty input */
     int *rank_lo, *rank_hi; /* per node: the ranks its primitives go to */
 } cs_bvh;
 
 int cs_bvh_build(cs_bvh *t, int nprims, const cs_box *prim_box);
 void cs_bvh_free(cs_bvh *t);
-/* Sets node boxes from primitive boxes; prim_dirty may be NULL (all clean). */
-void cs_bvh_refit(cs_bvh *t, const cs_box *prim_box, const unsigned char *prim_dirty);
+/* Sets node boxes from primitive boxes. */
+void cs_bvh_refit(cs_bvh *t, const cs_box *prim_box);
 
 /* Section 7: each primitive's rank (the lowest owner of its particles); a
  * pair goes to the lower of its two primitives' ranks. */
@@ -55,11 +53,10 @@ void cs_bvh_work_free(cs_bvh_work *w);
  * depth-first traversal whatever the thread count: the node pairs near the
  * top become tasks that OpenMP threads traverse into their own lists,
  * joined in task order. The boxes are those of the last cs_bvh_refit of
- * each tree. With only_dirty, node pairs where neither side is
- * dirty are skipped; with rank >= 0 (after cs_bvh_set_ranks on both trees),
+ * each tree. With rank >= 0 (after cs_bvh_set_ranks on both trees),
  * node pairs that cannot hold a pair going to rank. Returns 0 or -1 (no
  * memory). */
-int cs_bvh_collect(const cs_bvh *A, const cs_bvh *B, bool only_dirty, int rank, cs_bvh_work *w,
+int cs_bvh_collect(const cs_bvh *A, const cs_bvh *B, int rank, cs_bvh_work *w,
                    cs_index_pairs *out);
 
 static inline bool cs_box_overlap(const cs_box *a, const cs_box *b)

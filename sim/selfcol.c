@@ -22,7 +22,7 @@ void cs_selfcol_release(cs_selfcol *sc, int i, double mass) { sc->inv_mass[i] = 
 
 /* ------------------------------------------------------------ topology */
 
-static int pair_push(cs_pair_list *l, const int v[4], const double *s0)
+int sc_pair_push(cs_pair_list *l, const int v[4], const double *s0)
 {
     if (l->n == l->capacity) {
         int cap = l->capacity ? 2 * l->capacity : 256;
@@ -110,6 +110,7 @@ cs_selfcol *cs_selfcol_create(const cs_sim *sim)
     sc->tbox = calloc((size_t)nt + 1, sizeof *sc->tbox);
     sc->pdirty = calloc((size_t)n + 1, 1);
     sc->vdirty = calloc((size_t)n + 1, 1);
+    sc->collided = calloc((size_t)n + 1, 1);
     sc->edirty = calloc((size_t)ne + 1, 1);
     sc->tdirty = calloc((size_t)nt + 1, 1);
     sc->x_free = malloc(sizeof(double) * 3 * (size_t)(n + 1));
@@ -124,7 +125,7 @@ cs_selfcol *cs_selfcol_create(const cs_sim *sim)
     sc->x_pass = malloc(sizeof(double) * 3 * (size_t)(n + 1));
     if (!sc->prim_rank || !sc->component || !sc->x_pass)
         goto fail;
-    if (!sc->pbox || !sc->ebox || !sc->tbox || !sc->pdirty || !sc->vdirty || !sc->edirty ||
+    if (!sc->pbox || !sc->ebox || !sc->tbox || !sc->pdirty || !sc->vdirty || !sc->collided || !sc->edirty ||
         !sc->tdirty || !sc->x_free || !sc->x_before || !sc->inv_mass || !sc->zone ||
         !sc->zone_list)
         goto fail;
@@ -156,7 +157,9 @@ cs_selfcol *cs_selfcol_create(const cs_sim *sim)
     if (cs_bvh_build(&sc->ptree, n, sc->pbox) || cs_bvh_build(&sc->etree, ne, sc->ebox) ||
         cs_bvh_build(&sc->ttree, nt, sc->tbox))
         goto fail;
-    sc->bytes = sizeof(cs_box) * (size_t)(n + ne + nt) * 3 + sizeof(double) * 13 * (size_t)n +
+    if (sc_cache_create(sc))
+        goto fail;
+    sc->bytes = sizeof(cs_box) * (size_t)(n + ne + nt) * 4 + sizeof(double) * 13 * (size_t)n +
                 sizeof(int) * (size_t)(2 * ne + 3 * nt + 3 * n + most);
     return sc;
 fail:
@@ -171,17 +174,15 @@ void cs_selfcol_destroy(cs_selfcol *sc)
     cs_bvh_free(&sc->ptree);
     cs_bvh_free(&sc->etree);
     cs_bvh_free(&sc->ttree);
-    void *arrays[] = {sc->edge, sc->tri, sc->ring_start, sc->ring, sc->pbox, sc->ebox, sc->tbox, sc->pdirty, sc->edirty,
+    void *arrays[] = {sc->edge, sc->tri, sc->ring_start, sc->ring, sc->pbox, sc->ebox, sc->tbox, sc->pdirty, sc->collided, sc->edirty,
                       sc->tdirty, sc->vdirty, sc->x_free, sc->x_before, sc->inv_mass, sc->zone,
                       sc->zone_list, sc->pt.p, sc->ee.p, sc->cpt.p, sc->cee.p,
                       sc->prim_rank, sc->component, sc->bpt.p, sc->bee.p, sc->x_pass};
     for (size_t k = 0; k < sizeof arrays / sizeof *arrays; k++)
         free(arrays[k]);
     cs_halo_free(&sc->bhalo);
+    sc_cache_free(sc);
     cs_bvh_work_free(&sc->bvh_work);
-    free(sc->candidates.ab);
-    free(sc->made);
-    free(sc->keep);
     free(sc);
 }
 
@@ -443,6 +444,7 @@ int cs_selfcol_set_ranks(cs_sim *sim)
     const int *owner = sim->par->owner;
     if (sim->par->size == 1)
         return 0; /* nothing to prune */
+    sc->cache.valid = false; /* its pairs were pruned for other ranks */
     int *r = sc->prim_rank;
     for (int i = 0; i < sc->n; i++)
         r[i] = owner[i];
@@ -549,7 +551,7 @@ int sc_distribute_boundary(cs_sim *sim, cs_pair_list *pt, cs_pair_list *ee)
                 particle[4 * k + j] = all[k].v[j];
             }
             if (proc == par->rank)
-                rc = pair_push(l ? &sc->bee : &sc->bpt, all[k].v, all[k].s0);
+                rc = sc_pair_push(l ? &sc->bee : &sc->bpt, all[k].v, all[k].s0);
         }
     if (!rc)
         rc = cs_halo_from_needs(par, 4 * nall, user, particle, &sc->bhalo);
@@ -664,36 +666,6 @@ static bool make_repulsion_edge_edge(const void *ctx, int ea, int eb, cs_pair *o
     return true;
 }
 
-/* Traverses A against B and appends the pairs make accepts to list, in the
- * traversal's order at any thread count: threads make pairs from the
- * candidates in place, then they are kept in order. Returns 0 or -1. */
-int sc_find_pairs(cs_selfcol *sc, const cs_bvh *A, const cs_bvh *B, bool only_dirty, int rank,
-                  pair_maker make, const void *ctx, cs_pair_list *list)
-{
-    if (cs_bvh_collect(A, B, only_dirty, rank, &sc->bvh_work, &sc->candidates))
-        return -1;
-    int n = sc->candidates.n;
-    if (n > sc->made_capacity) {
-        cs_pair *made = realloc(sc->made, sizeof *made * (size_t)n);
-        unsigned char *keep = realloc(sc->keep, (size_t)n);
-        if (made)
-            sc->made = made;
-        if (keep)
-            sc->keep = keep;
-        if (!made || !keep)
-            return -1;
-        sc->made_capacity = n;
-    }
-    const int *ab = sc->candidates.ab;
-#pragma omp parallel for schedule(dynamic, 256)
-    for (int k = 0; k < n; k++)
-        sc->keep[k] = make(ctx, ab[2 * k], ab[2 * k + 1], sc->made + k);
-    for (int k = 0; k < n; k++)
-        if (sc->keep[k] && pair_push(list, sc->made[k].v, sc->made[k].s0))
-            return -1;
-    return 0;
-}
-
 void cs_selfcol_find_pairs(cs_sim *sim, double span)
 {
     cs_selfcol *sc = sim->selfcol;
@@ -739,15 +711,10 @@ void cs_selfcol_find_pairs(cs_sim *sim, double span)
             cs_box_add_point(b, sc->pbox[i].hi);
         }
     }
-    cs_bvh_refit(&sc->ptree, sc->pbox, NULL);
-    cs_bvh_refit(&sc->etree, sc->ebox, NULL);
-    cs_bvh_refit(&sc->ttree, sc->tbox, NULL);
     finder f = {sim, sc, thickness, span};
-    int rank = sim->par->rank;
-    int failed = sc_find_pairs(sc, &sc->ptree, &sc->ttree, false, rank,
-                               make_repulsion_point_triangle, &f, &sc->pt) ||
-                 sc_find_pairs(sc, &sc->etree, &sc->etree, false, rank, make_repulsion_edge_edge,
-                               &f, &sc->ee);
+    int failed = sc_cache_update(sc, sim->par->rank, thickness) ||
+                 sc_find_pairs(sc, false, false, make_repulsion_point_triangle, &f, &sc->pt) ||
+                 sc_find_pairs(sc, true, false, make_repulsion_edge_edge, &f, &sc->ee);
     sc->stats.repulsion_pairs += sc->pt.n + sc->ee.n;
     if (sc_distribute_boundary(sim, &sc->pt, &sc->ee) != 0)
         failed = 1;

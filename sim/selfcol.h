@@ -37,7 +37,31 @@ typedef struct cs_selfcol_stats {
     long max_zone;             /* particles in the largest zone */
     long zones_across;         /* zone rigidifications spanning ranks */
     long rewinds;              /* outer steps redone (rewind scheme) */
+    long cache_searches;       /* searches of steps A and C (selfcol_cache.c) */
+    long cache_builds;         /* of them, those that traversed the trees */
 } cs_selfcol_stats;
+
+/* A pair a search made, with the candidate (a, b) it came from: the key
+ * that orders a search's pairs. */
+typedef struct cs_made_pair {
+    int a, b;
+    cs_pair p;
+} cs_made_pair;
+
+typedef struct cs_made_list {
+    int n, capacity;
+    cs_made_pair *m;
+} cs_made_list;
+
+/* Candidate pairs kept between searches (selfcol_cache.c). */
+typedef struct cs_pair_cache {
+    bool valid;
+    double slack;                /* grown by this times the thickness; below
+                                    zero, every search traverses (tests) */
+    double anchor[3];            /* the centroid of x_free when it was built */
+    cs_box *pbox, *ebox, *tbox;  /* the boxes it was built from, grown */
+    cs_index_pairs pt, ee;       /* point/triangle, edge/edge */
+} cs_pair_cache;
 
 typedef struct cs_selfcol {
     int n, ne, nt;
@@ -46,6 +70,7 @@ typedef struct cs_selfcol {
     cs_bvh ptree, etree, ttree;
     cs_box *pbox, *ebox, *tbox;
     unsigned char *pdirty, *edirty, *tdirty, *vdirty;
+    unsigned char *collided;   /* step C: in a pair the last pass found */
     double *x_free;            /* the last collision-free positions */
     double *x_before;          /* positions when step C began */
     double *inv_mass;          /* 0 for pinned and scripted particles */
@@ -62,12 +87,11 @@ typedef struct cs_selfcol {
     cs_pair_list bpt, bee;     /* boundary repulsion pairs this rank processes */
     cs_halo bhalo;             /* their particles: owners <-> this rank */
     double *x_pass;            /* positions at the last step C pass's start */
-    /* traversal scratch (find_pairs): candidates, the pairs made of them */
+    cs_pair_cache cache;
+    /* search scratch: the traversal's, and the pairs each thread made */
     cs_bvh_work bvh_work;
-    cs_index_pairs candidates;
-    cs_pair *made;
-    unsigned char *keep;
-    int made_capacity;
+    cs_made_list *made;
+    int nmade;
     cs_selfcol_stats stats;
     size_t bytes;
 } cs_selfcol;

@@ -196,18 +196,29 @@ static bool make_collision_edge_edge(const void *ctx, int ea, int eb, cs_pair *o
 
 /* Swept boxes from the free positions to x, and the pairs among their
  * primitives that collide along the trajectories, with their history (only
- * near changed particles when only_dirty). Returns how many, or -1 when
- * memory ran out. */
+ * near changed particles when only_dirty). The boxes sweep in a frame
+ * moving with the cloth's mean displacement D over the span: two points
+ * meet at time s exactly when they meet after both are moved back by s D,
+ * and those moved trajectories are straight lines too, so a sheet falling
+ * rigidly sweeps no volume at all. Returns how many, or -1 when memory ran
+ * out. */
 static long find_collisions(cs_selfcol *sc, const cs_par *par, const double *x,
-                            bool only_dirty)
+                            double thickness, bool only_dirty)
 {
-    double pad = sc->proximity;
+    double pad = sc->proximity, D[3] = {0, 0, 0};
+    for (int i = 0; i < sc->n; i++)
+        for (int d = 0; d < 3; d++)
+            D[d] += x[3 * i + d] - sc->x_free[3 * i + d];
+    for (int d = 0; d < 3; d++)
+        D[d] = sc->n ? D[d] / sc->n : 0;
 #pragma omp parallel for schedule(static)
     for (int i = 0; i < sc->n; i++) {
         cs_box *b = sc->pbox + i;
+        double end[3];
+        cs_sub(x + 3 * i, D, end);
         cs_box_empty(b);
         cs_box_add_point(b, sc->x_free + 3 * i);
-        cs_box_add_point(b, x + 3 * i);
+        cs_box_add_point(b, end);
         cs_box_thicken(b, pad);
         sc->pdirty[i] = sc->vdirty[i];
     }
@@ -231,15 +242,11 @@ static long find_collisions(cs_selfcol *sc, const cs_par *par, const double *x,
         cs_box_add_point(b, sc->pbox[t[2]].hi);
         sc->tdirty[k] = sc->vdirty[t[0]] | sc->vdirty[t[1]] | sc->vdirty[t[2]];
     }
-    cs_bvh_refit(&sc->ptree, sc->pbox, sc->pdirty);
-    cs_bvh_refit(&sc->etree, sc->ebox, sc->edirty);
-    cs_bvh_refit(&sc->ttree, sc->tbox, sc->tdirty);
     sc->cpt.n = sc->cee.n = 0;
     collector cl = {sc, par, x};
-    if (sc_find_pairs(sc, &sc->ptree, &sc->ttree, only_dirty, par->rank,
-                      make_collision_point_triangle, &cl, &sc->cpt) ||
-        sc_find_pairs(sc, &sc->etree, &sc->etree, only_dirty, par->rank, make_collision_edge_edge,
-                      &cl, &sc->cee))
+    if (sc_cache_update(sc, par->rank, thickness) ||
+        sc_find_pairs(sc, false, only_dirty, make_collision_point_triangle, &cl, &sc->cpt) ||
+        sc_find_pairs(sc, true, only_dirty, make_collision_edge_edge, &cl, &sc->cee))
         return -1;
     return sc->cpt.n + sc->cee.n;
 }
@@ -483,13 +490,24 @@ long cs_selfcol_collide(cs_sim *sim, double span, int k, bool detect_only)
     for (int pass = 0;; pass++) {
         if (pass > 0) { /* what moved since the last pass, on any rank */
             cs_par_allgather(par, x, 3);
+            /* moved, or in a pair the last pass found: that pair may
+             * collide still though its response moved nothing (held
+             * particles, no approach) */
             for (int i = 0; i < n; i++)
-                sc->vdirty[i] = memcmp(x + 3 * i, sc->x_pass + 3 * i, 3 * sizeof *x) != 0;
+                sc->vdirty[i] = sc->collided[i] ||
+                                memcmp(x + 3 * i, sc->x_pass + 3 * i, 3 * sizeof *x) != 0;
         }
         memcpy(sc->x_pass, x, bytes);
-        long found = find_collisions(sc, par, x, pass > 0), found_all = found;
+        long found = find_collisions(sc, par, x, d->thickness, pass > 0), found_all = found;
         if (found < 0)
             abort(); /* out of memory finding collisions: no collision-free state to keep */
+        memset(sc->collided, 0, (size_t)n);
+        for (int l = 0; l < 2; l++) {
+            const cs_pair_list *list = l ? &sc->cee : &sc->cpt;
+            for (int j = 0; j < list->n; j++)
+                for (int q = 0; q < 4; q++)
+                    sc->collided[list->p[j].v[q]] = 1;
+        }
         sc->stats.passes++;
         bool zone_mode = pass >= d->zone_iterations;
         for (int i = 0; i < n; i++)

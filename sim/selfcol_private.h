@@ -17,9 +17,20 @@ typedef struct response {
     double thickness, k, mu, epsilon;
 } response;
 
+int sc_pair_push(cs_pair_list *l, const int v[4], const double *s0);
 int sc_distribute_boundary(cs_sim *sim, cs_pair_list *pt, cs_pair_list *ee);
-int sc_find_pairs(cs_selfcol *sc, const cs_bvh *A, const cs_bvh *B, bool only_dirty, int rank,
-                  pair_maker make, const void *ctx, cs_pair_list *list);
+/* Before steps A and C search with the boxes in sc->pbox, ebox and tbox
+ * (around x_free): makes the cache hold every pair whose boxes can overlap,
+ * traversing the trees only when a particle's box left its grown box.
+ * Returns 0 or -1 (no memory). */
+int sc_cache_update(cs_selfcol *sc, int rank, double thickness);
+int sc_cache_create(cs_selfcol *sc);
+void sc_cache_free(cs_selfcol *sc);
+/* The cached point/triangle (edges: edge/edge) pairs whose present boxes
+ * overlap (only_dirty: with a dirty side) and that make accepts, appended
+ * to list in (a, b) order at any thread count. Returns 0 or -1. */
+int sc_find_pairs(cs_selfcol *sc, bool edges, bool only_dirty, pair_maker make, const void *ctx,
+                  cs_pair_list *list);
 void sc_pair_impulse(const cs_selfcol *sc, const cs_pair *p, const double c[4], double J,
                      const double dir[3], double *v);
 double sc_pair_inverse_mass(const cs_selfcol *sc, const cs_pair *p, const double c[4]);

@@ -360,6 +360,8 @@ typedef struct cs_frame_stats {
     long impact_zones;         /* zones formed */
     long max_zone_size;        /* particles in the largest zone */
     long rewinds;              /* outer steps redone (rewind scheme) */
+    long pair_searches;        /* searches of steps A and C */
+    long pair_traversals;      /* of them, those that traversed the trees */
     long intersections;        /* verifier at frame end; -1 when not asked */
 } cs_frame_stats;
 

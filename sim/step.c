@@ -478,6 +478,8 @@ int cs_sim_advance_frame(cs_sim *sim, cs_frame_stats *stats)
             stats->impact_zones = self.zones - self0.zones;
             stats->max_zone_size = self.max_zone;
             stats->rewinds = self.rewinds - self0.rewinds;
+            stats->pair_searches = self.cache_searches - self0.cache_searches;
+            stats->pair_traversals = self.cache_builds - self0.cache_builds;
         }
         stats->intersections = intersections;
     }

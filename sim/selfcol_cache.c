@@ -1,0 +1,209 @@
+/* selfcol_cache.c: the candidate pairs of steps A and C kept from one
+ * search to the next (a Verlet list, as molecular dynamics keeps
+ * neighbours).
+ *
+ * A search's boxes (sc->pbox, ebox, tbox) lie around the collision-free
+ * positions x_free. Box overlap does not change when every box moves by the
+ * same translation, so the cache is built once from boxes grown by a slack,
+ * and a later search may use it while each particle's box, moved back by
+ * how far the cloth's centroid has gone, stays inside its grown box: every
+ * pair whose present boxes overlap then had overlapping grown boxes. A
+ * falling or sliding sheet moves nearly rigidly, so one traversal serves
+ * many outer steps; each search costs a containment test per particle and
+ * an overlap test per cached pair.
+ *
+ * A search's pairs are sorted by (a, b) (sc_find_pairs), so they come in
+ * one order whatever the cache's history (when it was built, or a run
+ * resumed from a checkpoint with an empty cache): the makers are exact,
+ * the boxes only a conservative filter, so the lists do not depend on the
+ * broad phase at all. */
+#include <math.h>
+#include <omp.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "sim/selfcol_private.h"
+
+/* The slack a rebuild grows each particle's box by, per thickness: wider
+ * lives longer but holds more pairs to filter (measured on the 100 x 100
+ * benchmark sheet; see README, "Speed at resolution"). */
+static const double CACHE_SLACK_PER_THICKNESS = 0.5;
+
+static void centroid(const cs_selfcol *sc, double c[3])
+{
+    double s[3] = {0, 0, 0};
+    for (int i = 0; i < sc->n; i++)
+        for (int d = 0; d < 3; d++)
+            s[d] += sc->x_free[3 * i + d];
+    for (int d = 0; d < 3; d++)
+        c[d] = sc->n ? s[d] / sc->n : 0;
+}
+
+/* Every present particle box, moved back by T, inside its grown box. The
+ * comparison uses the rounded moved corners, and rounding is monotone, so
+ * two present boxes that overlap still do once both are moved: no
+ * round-off allowance is needed. */
+static bool contained(const cs_selfcol *sc, const double T[3])
+{
+    const cs_box *grown = sc->cache.pbox;
+    int inside = 1;
+#pragma omp parallel for schedule(static) reduction(& : inside)
+    for (int i = 0; i < sc->n; i++)
+        for (int d = 0; d < 3; d++)
+            inside &= sc->pbox[i].lo[d] - T[d] >= grown[i].lo[d] &&
+                      sc->pbox[i].hi[d] - T[d] <= grown[i].hi[d];
+    return inside;
+}
+
+static int rebuild(cs_selfcol *sc, int rank, double thickness, const double anchor[3])
+{
+    cs_pair_cache *c = &sc->cache;
+    double slack = fmax(c->slack, 0) * thickness;
+    /* room for step A's boxes (half the thickness around x_free, more for
+     * particles moving relative to the rest) whichever search rebuilds */
+#pragma omp parallel for schedule(static)
+    for (int i = 0; i < sc->n; i++) {
+        cs_box *b = c->pbox + i, around;
+        *b = sc->pbox[i];
+        cs_box_empty(&around);
+        cs_box_add_point(&around, sc->x_free + 3 * i);
+        cs_box_thicken(&around, 0.5 * thickness);
+        cs_box_add_point(b, around.lo);
+        cs_box_add_point(b, around.hi);
+        cs_box_thicken(b, slack);
+    }
+#pragma omp parallel for schedule(static)
+    for (int k = 0; k < sc->ne; k++) {
+        cs_box *b = c->ebox + k;
+        *b = c->pbox[sc->edge[2 * k]];
+        cs_box_add_point(b, c->pbox[sc->edge[2 * k + 1]].lo);
+        cs_box_add_point(b, c->pbox[sc->edge[2 * k + 1]].hi);
+    }
+#pragma omp parallel for schedule(static)
+    for (int k = 0; k < sc->nt; k++) {
+        cs_box *b = c->tbox + k;
+        *b = c->pbox[sc->tri[3 * k]];
+        for (int j = 1; j < 3; j++) {
+            cs_box_add_point(b, c->pbox[sc->tri[3 * k + j]].lo);
+            cs_box_add_point(b, c->pbox[sc->tri[3 * k + j]].hi);
+        }
+    }
+    cs_bvh_refit(&sc->ptree, c->pbox);
+    cs_bvh_refit(&sc->etree, c->ebox);
+    cs_bvh_refit(&sc->ttree, c->tbox);
+    c->valid = false;
+    if (cs_bvh_collect(&sc->ptree, &sc->ttree, rank, &sc->bvh_work, &c->pt) ||
+        cs_bvh_collect(&sc->etree, &sc->etree, rank, &sc->bvh_work, &c->ee))
+        return -1;
+    memcpy(c->anchor, anchor, sizeof c->anchor);
+    c->valid = true;
+    sc->stats.cache_builds++;
+    return 0;
+}
+
+int sc_cache_update(cs_selfcol *sc, int rank, double thickness)
+{
+    double now[3], T[3];
+    centroid(sc, now);
+    sc->stats.cache_searches++;
+    if (sc->cache.valid && sc->cache.slack >= 0) {
+        for (int d = 0; d < 3; d++)
+            T[d] = now[d] - sc->cache.anchor[d];
+        if (contained(sc, T))
+            return 0;
+    }
+    return rebuild(sc, rank, thickness, now);
+}
+
+int sc_cache_create(cs_selfcol *sc)
+{
+    cs_pair_cache *c = &sc->cache;
+    c->slack = CACHE_SLACK_PER_THICKNESS;
+    c->pbox = malloc(sizeof *c->pbox * ((size_t)sc->n + 1));
+    c->ebox = malloc(sizeof *c->ebox * ((size_t)sc->ne + 1));
+    c->tbox = malloc(sizeof *c->tbox * ((size_t)sc->nt + 1));
+    return c->pbox && c->ebox && c->tbox ? 0 : -1;
+}
+
+void sc_cache_free(cs_selfcol *sc)
+{
+    cs_pair_cache *c = &sc->cache;
+    free(c->pbox);
+    free(c->ebox);
+    free(c->tbox);
+    free(c->pt.ab);
+    free(c->ee.ab);
+    memset(c, 0, sizeof *c);
+    for (int t = 0; t < sc->nmade; t++)
+        free(sc->made[t].m);
+    free(sc->made);
+    sc->made = NULL;
+    sc->nmade = 0;
+}
+
+static int made_push(cs_made_list *l, int a, int b, const cs_pair *p)
+{
+    if (l->n == l->capacity) {
+        int cap = l->capacity ? 2 * l->capacity : 256;
+        cs_made_pair *m = realloc(l->m, sizeof *m * (size_t)cap);
+        if (!m)
+            return -1;
+        l->m = m;
+        l->capacity = cap;
+    }
+    l->m[l->n++] = (cs_made_pair){a, b, *p};
+    return 0;
+}
+
+static int by_candidate(const void *pa, const void *pb)
+{
+    const cs_made_pair *x = pa, *y = pb;
+    return x->a != y->a ? (x->a > y->a) - (x->a < y->a) : (x->b > y->b) - (x->b < y->b);
+}
+
+int sc_find_pairs(cs_selfcol *sc, bool edges, bool only_dirty, pair_maker make, const void *ctx,
+                  cs_pair_list *list)
+{
+    const cs_index_pairs *cand = edges ? &sc->cache.ee : &sc->cache.pt;
+    const cs_box *boxa = edges ? sc->ebox : sc->pbox, *boxb = edges ? sc->ebox : sc->tbox;
+    const unsigned char *da = edges ? sc->edirty : sc->pdirty;
+    const unsigned char *db = edges ? sc->edirty : sc->tdirty;
+    int threads = omp_get_max_threads();
+    if (threads > sc->nmade) {
+        cs_made_list *m = realloc(sc->made, sizeof *m * (size_t)threads);
+        if (!m)
+            return -1;
+        memset(m + sc->nmade, 0, sizeof *m * (size_t)(threads - sc->nmade));
+        sc->made = m;
+        sc->nmade = threads;
+    }
+    int failed = 0;
+#pragma omp parallel reduction(| : failed)
+    {
+        cs_made_list *mine = sc->made + omp_get_thread_num();
+        mine->n = 0;
+#pragma omp for schedule(dynamic, 1024)
+        for (int k = 0; k < cand->n; k++) {
+            int a = cand->ab[2 * k], b = cand->ab[2 * k + 1];
+            cs_pair p;
+            if ((only_dirty && !da[a] && !db[b]) || !cs_box_overlap(boxa + a, boxb + b) ||
+                !make(ctx, a, b, &p))
+                continue;
+            failed |= made_push(mine, a, b, &p);
+        }
+    }
+    if (failed)
+        return -1;
+    /* the threads' pairs joined, then in (a, b) order */
+    cs_made_list *all = sc->made;
+    for (int t = 1; t < threads; t++)
+        for (int k = 0; k < sc->made[t].n; k++)
+            if (made_push(all, sc->made[t].m[k].a, sc->made[t].m[k].b, &sc->made[t].m[k].p))
+                return -1;
+    if (all->n > 1)
+        qsort(all->m, (size_t)all->n, sizeof *all->m, by_candidate);
+    for (int k = 0; k < all->n; k++)
+        if (sc_pair_push(list, all->m[k].p.v, all->m[k].p.s0))
+            return -1;
+    return 0;
+}
