@@ -124,8 +124,9 @@ int cs_springs_add_mesh(cs_springs *s, int offset, int nv, int nt, const int *tr
 
 static void free_rows(cs_springs *s)
 {
-    void *rows[] = {s->row_start, s->row_other, s->row_sqrt_damping, s->row_direction,
-                    s->row_magnitude, s->row_stiffness, s->row_inv_rest_length};
+    void *rows[] = {s->row_start,     s->row_other,     s->row_mirror,
+                    s->row_sqrt_damping, s->row_direction, s->row_magnitude,
+                    s->row_stiffness, s->row_inv_rest_length};
     for (size_t k = 0; k < sizeof rows / sizeof *rows; k++)
         free(rows[k]);
 }
@@ -142,8 +143,9 @@ int cs_springs_index(cs_springs *s, int nrows, const int *particles, int npartic
     s->row_particle = particles;
     s->row_start = calloc((size_t)nrows + 1, sizeof *s->row_start);
     s->row_other = malloc(sizeof *s->row_other * (2 * (size_t)s->n + 1));
+    s->row_mirror = malloc(sizeof *s->row_mirror * (2 * (size_t)s->n + 1));
     int *row_of = malloc(sizeof *row_of * ((size_t)nparticles + 1));
-    if (!s->row_start || !s->row_other || !row_of || !s->row_sqrt_damping ||
+    if (!s->row_start || !s->row_other || !s->row_mirror || !row_of || !s->row_sqrt_damping ||
         !s->row_direction || !s->row_magnitude || !s->row_stiffness || !s->row_inv_rest_length) {
         free(row_of);
         return -1;
@@ -165,16 +167,22 @@ int cs_springs_index(cs_springs *s, int nrows, const int *particles, int npartic
         return -1;
     }
     memcpy(fill, s->row_start, sizeof *fill * (size_t)nrows);
-    for (int k = 0; k < s->n; k++) /* ascending k: each row in spring order */
+    for (int k = 0; k < s->n; k++) { /* ascending k: each row in spring order */
+        int at[2] = {-1, -1};
         for (int e = 0; e < 2; e++) {
             int r = row_of[s->ends[2 * k + e]];
             if (r < 0)
                 continue;
+            at[e] = fill[r];
             s->row_sqrt_damping[fill[r]] = sqrt(s->damping[k]);
             s->row_stiffness[fill[r]] = s->stiffness[k];
             s->row_inv_rest_length[fill[r]] = s->inv_rest_length[k];
             s->row_other[fill[r]++] = s->ends[2 * k + 1 - e];
         }
+        for (int e = 0; e < 2; e++)
+            if (at[e] >= 0)
+                s->row_mirror[at[e]] = at[1 - e];
+    }
     free(fill);
     free(row_of);
     return 0;
@@ -198,12 +206,18 @@ void cs_springs_free(cs_springs *s)
  * scatter's numbers bit for bit. */
 void cs_springs_prepare(cs_springs *s, const double *x)
 {
-    /* every row entry from its own end, so the writes stream: the far end's
-     * entry gets -u exactly, which the gathers turn into the same sums */
+    /* a spring with both ends in rows is computed once, from its first
+     * entry, which writes the mirror entry too: the far end's direction is
+     * -u exactly (x_i - x_j = -(x_j - x_i) in floating point, and l, the
+     * constants and so the magnitude are the same), so the sums are the
+     * same bits as computing both ends; each entry has one writer */
 #pragma omp parallel for schedule(static)
     for (int r = 0; r < s->nrows; r++) {
         const double *xi = x + 3 * s->row_particle[r];
         for (int e = s->row_start[r]; e < s->row_start[r + 1]; e++) {
+            int m = s->row_mirror[e];
+            if (m >= 0 && m < e)
+                continue;
             double *u = s->row_direction + 3 * e;
             cs_sub(x + 3 * s->row_other[e], xi, u);
             double l = cs_norm(u);
@@ -215,6 +229,11 @@ void cs_springs_prepare(cs_springs *s, const double *x)
             double scale = inv * s->row_sqrt_damping[e];
             for (int d = 0; d < 3; d++)
                 u[d] *= scale;
+            if (m >= 0) {
+                s->row_magnitude[m] = s->row_magnitude[e];
+                for (int d = 0; d < 3; d++)
+                    s->row_direction[3 * m + d] = -u[d];
+            }
         }
     }
 }

@@ -31,6 +31,7 @@ typedef struct cs_springs {
     int nrows;
     const int *row_particle;
     int *row_start, *row_other;
+    int *row_mirror;     /* the same spring's entry in its far end's row, or -1 */
     /* per row entry, so the gathers stream: the spring's constants, and
      * from cs_springs_prepare its direction seen from the row's particle,
      * scaled by sqrt(d) (w = sqrt(d) u_hat, so the damping force is
