@@ -8,7 +8,9 @@ on (verifier on: every frame must end with 0 intersecting pairs) and off,
 each REPEAT times as one plain `clothsim run` (no launcher, default threads).
 Prints per case the median wall seconds per frame over the whole run, steps
 and CG iterations per frame, peak memory, intersecting pairs, the stage table
-of the median run, the exponent of seconds per frame against triangles, and
+of the median run, a free-fall frame with self-collision against one
+without (median over the frames before the first body contact), the
+exponent of seconds per frame against triangles, and
 for the largest case the inner step's cost in ns per spring per step and as
 estimated memory traffic against a STREAM triad measured in the same run.
 
@@ -111,6 +113,10 @@ def main():
             inter = [f.get("intersections") for f in frames if f.get("intersections") is not None]
             steps = sum(f.get("steps", 0) for f in frames)
             cg = sum(f.get("cg_iterations", 0) for f in frames)
+            # free fall: the frames before the cloth first touches a body
+            first_contact = next((k for k, f in enumerate(frames) if f.get("body_contacts", 0) > 0),
+                                 len(frames))
+            free_fall = [f["seconds"] for f in frames[:first_contact] if "seconds" in f]
             stages = {st["name"]: st["seconds"] for st in s.get("stages", [])}
             inner = sum(stages.get(k, 0) for k in INNER_STAGES)
             springs = s.get("springs", 0)
@@ -123,6 +129,8 @@ def main():
                 "steps_per_frame": steps / max(len(frames), 1),
                 "cg_per_frame": cg / max(len(frames), 1),
                 "peak_mib": max(x[1] for x in runs),
+                "free_fall_s_per_frame": statistics.median(free_fall) if free_fall else 0.0,
+                "free_fall_frames": len(free_fall),
                 "max_intersections": max(inter) if inter else "",
                 "frames_checked": len(inter),
                 "ns_per_spring_step": 1e9 * inner / max(steps * springs, 1),
@@ -162,6 +170,16 @@ def main():
             md.append("\nself-collision %s: seconds per frame ~ triangles^%.2f "
                       "(explicit elastic forces: steps ~ edge length^-1.5 ~ triangles^0.75, "
                       "work per step ~ triangles, so 1.75 expected)" % (mode, slope))
+    for n in sizes:
+        on = [r for r in rows if r["quads"] == n and r["self_collision"] == "on"]
+        off = [r for r in rows if r["quads"] == n and r["self_collision"] == "off"]
+        if on and off and on[0]["free_fall_frames"] and off[0]["free_fall_frames"]:
+            md.append("\n%dx%d: a free-fall frame (median over the %d frames before the first body "
+                      "contact) costs %.3f s with self-collision and %.3f s without: %.2f times "
+                      "(issue 10: at most 1.3)" % (
+                          n, n, on[0]["free_fall_frames"], on[0]["free_fall_s_per_frame"],
+                          off[0]["free_fall_s_per_frame"],
+                          on[0]["free_fall_s_per_frame"] / off[0]["free_fall_s_per_frame"]))
     big = max(rows, key=lambda r: (r["triangles"], r["self_collision"] == "on"))
     if bw:
         md.append("\n%dx%d: inner step %.2f ns per spring per step; modelled traffic %.1f GB/s "
