@@ -125,8 +125,8 @@ cs_selfcol *cs_selfcol_create(const cs_sim *sim)
     sc->x_pass = malloc(sizeof(double) * 3 * (size_t)(n + 1));
     if (!sc->prim_rank || !sc->component || !sc->x_pass)
         goto fail;
-    if (!sc->pbox || !sc->ebox || !sc->tbox || !sc->pdirty || !sc->vdirty || !sc->collided || !sc->edirty ||
-        !sc->tdirty || !sc->x_free || !sc->x_before || !sc->inv_mass || !sc->zone ||
+    if (!sc->pbox || !sc->ebox || !sc->tbox || !sc->pdirty || !sc->vdirty || !sc->collided ||
+        !sc->edirty || !sc->tdirty || !sc->x_free || !sc->x_before || !sc->inv_mass || !sc->zone ||
         !sc->zone_list)
         goto fail;
     memcpy(sc->x_free, sim->x, sizeof(double) * 3 * (size_t)n);
