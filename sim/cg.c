@@ -32,6 +32,62 @@ static inline void system_row(const cs_sim *sim, int r, int i, const double *v, 
         out[d] = sim->mass[i] * v[3 * i + d] - sim->half_dt * acc[d];
 }
 
+/* Row r's damping force (D v) added into acc, as cs_springs_damping_row,
+ * and in the same walk over its springs B = the 6 distinct entries (xx yy
+ * zz xy xz yz) of its diagonal block of D, negated: sum of w w^T */
+static inline void damping_row_and_block(const cs_springs *s, int r, const double *v,
+                                         double acc[3], double B[6])
+{
+    const double *vi = v + 3 * s->row_particle[r];
+    double b0 = 0, b1 = 0, b2 = 0, b3 = 0, b4 = 0, b5 = 0;
+    for (int e = s->row_start[r]; e < s->row_start[r + 1]; e++) {
+        const double *w = s->row_direction + 3 * e, *vo = v + 3 * s->row_other[e];
+        double w0 = w[0], w1 = w[1], w2 = w[2];
+        double mag = (vo[0] - vi[0]) * w0 + (vo[1] - vi[1]) * w1 + (vo[2] - vi[2]) * w2;
+        acc[0] += mag * w0;
+        acc[1] += mag * w1;
+        acc[2] += mag * w2;
+        b0 += w0 * w0;
+        b1 += w1 * w1;
+        b2 += w2 * w2;
+        b3 += w0 * w1;
+        b4 += w0 * w2;
+        b5 += w1 * w2;
+    }
+    B[0] = b0, B[1] = b1, B[2] = b2, B[3] = b3, B[4] = b4, B[5] = b5;
+}
+
+/* B += the wind drag's block c n n^T */
+static inline void wind_block(const cs_sim *sim, int i, double B[6])
+{
+    const double *nd = sim->wind_normal + 3 * i;
+    double c = sim->def.wind.drag * sim->wind_area[i];
+    B[0] += c * nd[0] * nd[0];
+    B[1] += c * nd[1] * nd[1];
+    B[2] += c * nd[2] * nd[2];
+    B[3] += c * nd[0] * nd[1];
+    B[4] += c * nd[0] * nd[2];
+    B[5] += c * nd[1] * nd[2];
+}
+
+/* inv = the inverse of the particle's block m I + (dt/2) B of M - (dt/2) D
+ * (the damping acts along spring directions, which a diagonal alone
+ * misses), by cofactors and one division; the block is symmetric positive
+ * definite */
+static inline void invert_block(double m, double hd, const double B[6], double inv[6])
+{
+    double a = m + hd * B[0], b = m + hd * B[1], cz = m + hd * B[2];
+    double xy = hd * B[3], xz = hd * B[4], yz = hd * B[5];
+    double c00 = b * cz - yz * yz, c01 = xz * yz - xy * cz, c02 = xy * yz - xz * b;
+    double inv_det = 1.0 / (a * c00 + xy * c01 + xz * c02);
+    inv[0] = c00 * inv_det;
+    inv[1] = (a * cz - xz * xz) * inv_det;
+    inv[2] = (a * b - xy * xy) * inv_det;
+    inv[3] = c01 * inv_det;
+    inv[4] = c02 * inv_det;
+    inv[5] = (xy * xz - a * yz) * inv_det;
+}
+
 /* P: fixed velocities and contact normals projected out */
 static inline void project_row(const cs_sim *sim, int i, double a[3])
 {
@@ -52,7 +108,8 @@ static inline void precondition(const double inv[6], const double r[3], double o
 }
 
 /* y_i = P B_i^-1 r_i, adding r_i . y_i to *sum and raising *worst to the
- * residual in velocity units |r_i| / m_i */
+ * squared residual in velocity units |r_i|^2 / m_i^2 (squared: no square
+ * root or division per particle; the caller takes one root of the max) */
 static inline void precondition_row(const cs_sim *sim, int i, const double *ri, double *yi,
                                     double *sum, double *worst)
 {
@@ -60,7 +117,8 @@ static inline void precondition_row(const cs_sim *sim, int i, const double *ri, 
     project_row(sim, i, yi);
     for (int d = 0; d < 3; d++)
         *sum += ri[d] * yi[d];
-    double res = cs_norm(ri) / sim->mass[i];
+    double inv_m = sim->cg.inv_mass[i];
+    double res = cs_dot(ri, ri) * (inv_m * inv_m);
     if (res > *worst)
         *worst = res;
 }
@@ -101,7 +159,7 @@ static double reduce(cs_sim *sim, const double *sum, const double *max, double *
     }
     if (max) {
         cs_par_sum_max(sim->par, &s, &m);
-        *max_out = m;
+        *max_out = sqrt(m); /* the blocks' maxima are squared residuals */
     } else {
         cs_par_sum(sim->par, &s, 1);
     }
@@ -128,47 +186,6 @@ int cs_cg_solve(cs_sim *sim, double *v0, const double *rhs, double *v, double *w
     const cs_springs *s = &sim->springs;
     double *part_sum = w->partial, *part_max = w->partial + block_count(par);
 
-    /* Block Jacobi preconditioner: the inverse of each particle's 3 x 3
-     * diagonal block of M - (dt/2) D (the damping acts along spring directions,
-     * which a diagonal alone misses), stored as its 6 distinct entries */
-#pragma omp parallel for schedule(static)
-    for (int r = 0; r < par->nowned; r++) {
-        int i = own[r];
-        double B[6] = {0, 0, 0, 0, 0, 0}; /* xx yy zz xy xz yz of D's block, negated */
-        for (int e = s->row_start[r]; e < s->row_start[r + 1]; e++) {
-            const double *w = s->row_direction + 3 * e; /* sqrt(d) u_hat */
-            B[0] += w[0] * w[0];
-            B[1] += w[1] * w[1];
-            B[2] += w[2] * w[2];
-            B[3] += w[0] * w[1];
-            B[4] += w[0] * w[2];
-            B[5] += w[1] * w[2];
-        }
-        if (sim->wind_normal) {
-            const double *nd = sim->wind_normal + 3 * i;
-            double c = sim->def.wind.drag * sim->wind_area[i];
-            B[0] += c * nd[0] * nd[0];
-            B[1] += c * nd[1] * nd[1];
-            B[2] += c * nd[2] * nd[2];
-            B[3] += c * nd[0] * nd[1];
-            B[4] += c * nd[0] * nd[2];
-            B[5] += c * nd[1] * nd[2];
-        }
-        double m = sim->mass[i], hd = sim->half_dt;
-        double a = m + hd * B[0], b = m + hd * B[1], cz = m + hd * B[2];
-        double xy = hd * B[3], xz = hd * B[4], yz = hd * B[5];
-        /* inverse by cofactors; the block is symmetric positive definite */
-        double c00 = b * cz - yz * yz, c01 = xz * yz - xy * cz, c02 = xy * yz - xz * b;
-        double det = a * c00 + xy * c01 + xz * c02;
-        double *inv = w->block + 6 * i;
-        inv[0] = c00 / det;
-        inv[1] = (a * cz - xz * xz) / det;
-        inv[2] = (a * b - xy * xy) / det;
-        inv[3] = c01 / det;
-        inv[4] = c02 / det;
-        inv[5] = (xy * xz - a * yz) / det;
-    }
-
     /* Start from the explicit update z = P M^-1 r0, exact when the damping
      * does no work (rigid motion). Starting from z = 0 would let a loose
      * tolerance (Table 1's 1e-3 m/s) swallow a step's whole acceleration
@@ -176,21 +193,29 @@ int cs_cg_solve(cs_sim *sim, double *v0, const double *rhs, double *v, double *w
      * With warm, add the damping response of this solve's previous call
      * (projected by today's contacts): it changes little from one step to
      * the next, so CG starts near the answer (the stopping test is the
-     * same, only fewer iterations reach it). */
+     * same, only fewer iterations reach it). The same pass over the springs
+     * builds the block Jacobi preconditioner. */
     cs_halo_forward(par, &par->ghosts, v0, 3);
 #pragma omp parallel for schedule(static)
     for (int r = 0; r < par->nowned; r++) {
         int i = own[r];
-        double q[3], ri[3];
-        system_row(sim, r, i, v0, q);
+        double acc[3] = {0, 0, 0}, B[6];
+        damping_row_and_block(s, r, v0, acc, B);
+        if (sim->wind_normal) {
+            wind_row(sim, i, v0, acc);
+            wind_block(sim, i, B);
+        }
+        invert_block(sim->mass[i], sim->half_dt, B, w->block + 6 * i);
+        double ri[3];
         for (int d = 0; d < 3; d++)
-            ri[d] = rhs[3 * i + d] - q[d];
+            ri[d] = rhs[3 * i + d] - (sim->mass[i] * v0[3 * i + d] - sim->half_dt * acc[d]);
         project_row(sim, i, ri);
         double *wi = warm ? warm + 3 * i : NULL;
         if (wi)
             project_row(sim, i, wi);
+        double inv_m = w->inv_mass[i];
         for (int d = 0; d < 3; d++) {
-            w->explicit_z[3 * i + d] = ri[d] / sim->mass[i];
+            w->explicit_z[3 * i + d] = ri[d] * inv_m;
             w->z[3 * i + d] = w->explicit_z[3 * i + d] + (wi ? wi[d] : 0);
             w->y[3 * i + d] = v0[3 * i + d] + w->z[3 * i + d];
         }

@@ -46,6 +46,7 @@ typedef struct cs_cg_work {
     double *block;               /* 6 per particle: the preconditioner's 3 x 3 inverse */
     double *warm_half, *warm_full; /* last damping responses of B.1 and B.5 */
     double *partial;  /* 2 per block: a partial sum and a partial maximum */
+    double *inv_mass; /* 1 / m per particle: multiplies where the solve divided */
 } cs_cg_work;
 
 struct cs_sim {

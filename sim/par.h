@@ -62,6 +62,14 @@ typedef struct cs_par {
         for (int i = (ranges)[2 * r_##i]; i < (ranges)[2 * r_##i + 1]; i++)
 #define CS_FOR_OWNED(par, i) CS_FOR_RANGES((par)->own, (par)->nown, i)
 #define CS_FOR_LOCAL(par, i) CS_FOR_RANGES((par)->local, (par)->nlocal, i)
+/* The same loops shared among the OpenMP threads, each range in fixed
+ * contiguous shares: for per-particle work with no reduction. */
+#define CS_PARALLEL_FOR_RANGES(ranges, nranges, i)                                 \
+    for (int r_##i = 0; r_##i < (nranges); r_##i++)                                \
+        _Pragma("omp parallel for schedule(static)")                               \
+        for (int i = (ranges)[2 * r_##i]; i < (ranges)[2 * r_##i + 1]; i++)
+#define CS_PARALLEL_FOR_OWNED(par, i) CS_PARALLEL_FOR_RANGES((par)->own, (par)->nown, i)
+#define CS_PARALLEL_FOR_LOCAL(par, i) CS_PARALLEL_FOR_RANGES((par)->local, (par)->nlocal, i)
 
 /* Partitions n particles at positions x by recursive median split over
  * the ranks of comm; springs (2 ends each) decide the ghosts. Returns NULL

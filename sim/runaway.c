@@ -98,22 +98,28 @@ void cs_runaway_begin_step(cs_sim *sim, double t1)
 
 void cs_runaway_check(cs_sim *sim, const double *v, cs_stage stage)
 {
-    double worst = 0;
-    bool bad = false;
-    CS_FOR_OWNED(sim->par, i) {
-        if (!sim->is_free[i])
-            continue;
-        const double *vi = v + 3 * i;
-        double s2 = vi[0] * vi[0] + vi[1] * vi[1] + vi[2] * vi[2];
-        if (!(s2 <= sim->runaway.limit2)) { /* NaN too */
-            bad = true;
-            if (!(s2 <= worst)) /* keeps a NaN */
+    /* threaded: the largest squared speed and whether any is NaN; a
+     * maximum and an or are the same at every thread count */
+    double worst = 0, limit2 = sim->runaway.limit2;
+    int nan_seen = 0;
+    const unsigned char *is_free = sim->is_free;
+    for (int r = 0; r < sim->par->nown; r++) {
+        int lo = sim->par->own[2 * r], hi = sim->par->own[2 * r + 1];
+#pragma omp parallel for schedule(static) reduction(max : worst) reduction(|| : nan_seen)
+        for (int i = lo; i < hi; i++) {
+            if (!is_free[i])
+                continue;
+            const double *vi = v + 3 * i;
+            double s2 = vi[0] * vi[0] + vi[1] * vi[1] + vi[2] * vi[2];
+            if (s2 != s2)
+                nan_seen = 1;
+            else if (s2 > worst)
                 worst = s2;
         }
     }
-    if (bad && sim->runaway.stage < 0) {
+    if ((nan_seen || worst > limit2) && sim->runaway.stage < 0) {
         sim->runaway.stage = stage;
-        sim->runaway.speed = sqrt(worst);
+        sim->runaway.speed = nan_seen ? NAN : sqrt(worst);
     }
 }
 
@@ -126,13 +132,20 @@ bool cs_runaway_end_step(cs_sim *sim)
         verdict[0] = CS_STAGE_COUNT - sim->runaway.stage;
         verdict[1] = isnan(sim->runaway.speed) ? INFINITY : sim->runaway.speed;
     }
-    CS_FOR_OWNED(sim->par, i)
-        for (int d = 0; d < 3; d++)
-            if (!isfinite(sim->x[3 * i + d]) || !isfinite(sim->v[3 * i + d])) {
-                if (verdict[0] == 0)
-                    verdict[0] = CS_STAGE_COUNT - CS_STAGE_VELOCITY_FULL;
-                verdict[1] = INFINITY;
-            }
+    int not_finite = 0;
+    const double *x = sim->x, *v = sim->v;
+    for (int r = 0; r < sim->par->nown; r++) {
+        int lo = 3 * sim->par->own[2 * r], hi = 3 * sim->par->own[2 * r + 1];
+#pragma omp parallel for schedule(static) reduction(|| : not_finite)
+        for (int k = lo; k < hi; k++)
+            if (!isfinite(x[k]) || !isfinite(v[k]))
+                not_finite = 1;
+    }
+    if (not_finite) {
+        if (verdict[0] == 0)
+            verdict[0] = CS_STAGE_COUNT - CS_STAGE_VELOCITY_FULL;
+        verdict[1] = INFINITY;
+    }
     cs_par_begin(sim->par, CS_STAGE_VELOCITY_FULL); /* B.6's result checked */
     cs_par_max(sim->par, verdict, 2);
     if (verdict[0] == 0)

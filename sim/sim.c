@@ -233,6 +233,7 @@ int cs_sim_create_checked(const cs_sim_def *def, cs_sim **out, char *err, size_t
             ok = (*scratch[k] = alloc3(n)) != NULL;
         ok = ok && (sim->cg.partial = calloc(2 * ((size_t)n / CS_BLOCK + 1), sizeof(double)));
         ok = ok && (sim->cg.block = calloc(6 * (size_t)n + 6, sizeof(double)));
+        ok = ok && (sim->cg.inv_mass = calloc((size_t)n + 1, sizeof(double)));
     }
     if (!ok)
         goto nomem;
@@ -253,6 +254,9 @@ int cs_sim_create_checked(const cs_sim_def *def, cs_sim **out, char *err, size_t
         memcpy(cs->mesh->tri, m->tri, sizeof *m->tri * 3 * (size_t)m->nt);
         memcpy(sim->x + 3 * offset, m->x, sizeof *m->x * 3 * (size_t)m->nv);
         cloth_masses(cl, sim->mass + offset);
+        if (sim->cg.inv_mass) /* not with plan_only */
+            for (int i = 0; i < m->nv; i++)
+                sim->cg.inv_mass[offset + i] = 1.0 / sim->mass[offset + i];
         for (int i = 0; i < m->nv; i++) {
             memcpy(sim->v + 3 * (offset + i), cl->velocity, 3 * sizeof(double));
             sim->is_free[offset + i] = 1;
@@ -434,7 +438,7 @@ void cs_sim_destroy(cs_sim *sim)
                         sim->script_v, sim->contact_normal, sim->wind_normal, sim->wind_area, sim->v_rewind,
                         sim->cg.z, sim->cg.r, sim->cg.y, sim->cg.p, sim->cg.q,
                         sim->cg.b, sim->cg.partial, sim->cg.explicit_z, sim->cg.warm_half,
-                        sim->cg.warm_full, sim->cg.block};
+                        sim->cg.warm_full, sim->cg.block, sim->cg.inv_mass};
     for (size_t k = 0; k < sizeof arrays / sizeof *arrays; k++)
         free(arrays[k]);
     free(sim->is_free);

@@ -218,21 +218,28 @@ void cs_springs_prepare(cs_springs *s, const double *x)
             int m = s->row_mirror[e];
             if (m >= 0 && m < e)
                 continue;
-            double *u = s->row_direction + 3 * e;
-            cs_sub(x + 3 * s->row_other[e], xi, u);
-            double l = cs_norm(u);
+            /* u in registers: writing it and reading it back as a
+             * vector stalled on store forwarding (perf: 44% of this loop) */
+            const double *xo = x + 3 * s->row_other[e];
+            double u[3] = {xo[0] - xi[0], xo[1] - xi[1], xo[2] - xi[2]};
+            double l = sqrt(u[0] * u[0] + u[1] * u[1] + u[2] * u[2]);
             /* one division: E (l / L0 - 1) / l = E / L0 - E / l, and u / l
              * (coincident ends: no direction to push along) */
             double inv = l > 0 ? 1.0 / l : 0;
-            s->row_magnitude[e] =
-                l > 0 ? s->row_stiffness[e] * (s->row_inv_rest_length[e] - inv) : 0;
+            double mag = l > 0 ? s->row_stiffness[e] * (s->row_inv_rest_length[e] - inv) : 0;
             double scale = inv * s->row_sqrt_damping[e];
-            for (int d = 0; d < 3; d++)
-                u[d] *= scale;
+            double w[3] = {u[0] * scale, u[1] * scale, u[2] * scale};
+            double *we = s->row_direction + 3 * e;
+            we[0] = w[0];
+            we[1] = w[1];
+            we[2] = w[2];
+            s->row_magnitude[e] = mag;
             if (m >= 0) {
-                s->row_magnitude[m] = s->row_magnitude[e];
-                for (int d = 0; d < 3; d++)
-                    s->row_direction[3 * m + d] = -u[d];
+                double *wm = s->row_direction + 3 * m;
+                wm[0] = -w[0];
+                wm[1] = -w[1];
+                wm[2] = -w[2];
+                s->row_magnitude[m] = mag;
             }
         }
     }

@@ -99,32 +99,25 @@ static void wind_geometry(cs_sim *sim, const double *x)
     }
 }
 
-/* force = elastic(x) + m g + explicit wind part, for owned particles (the
- * springs also add into ghosts, which nobody reads) */
-static void explicit_forces(cs_sim *sim, const double *x)
+/* force = elastic(x) + m g + explicit wind part, and the solve's right-hand
+ * side rhs = M v_start + (dt / 2) force, for owned particles (the ghosts'
+ * forces are zero); one threaded pass after the springs' */
+static void explicit_forces(cs_sim *sim, const double *x, const double *v_start)
 {
-    CS_FOR_LOCAL(sim->par, i)
+    CS_PARALLEL_FOR_LOCAL(sim->par, i)
         sim->force[3 * i] = sim->force[3 * i + 1] = sim->force[3 * i + 2] = 0;
     cs_springs_add_elastic(&sim->springs, x, sim->force);
-    CS_FOR_OWNED(sim->par, i)
-        cs_axpy(sim->mass[i], sim->def.gravity, sim->force + 3 * i);
-    if (sim->wind_normal) {
-        double c = sim->def.wind.drag;
-        CS_FOR_OWNED(sim->par, i) {
+    double c = sim->def.wind.drag;
+    CS_PARALLEL_FOR_OWNED(sim->par, i) {
+        double *f = sim->force + 3 * i;
+        cs_axpy(sim->mass[i], sim->def.gravity, f);
+        if (sim->wind_normal) {
             const double *nrm = sim->wind_normal + 3 * i;
-            cs_axpy(c * sim->wind_area[i] * cs_dot(nrm, sim->def.wind.velocity), nrm,
-                    sim->force + 3 * i);
+            cs_axpy(c * sim->wind_area[i] * cs_dot(nrm, sim->def.wind.velocity), nrm, f);
         }
-    }
-}
-
-/* rhs = M v_start + (dt / 2) force */
-static void momentum_rhs(cs_sim *sim, const double *v_start)
-{
-    CS_FOR_OWNED(sim->par, i)
         for (int d = 0; d < 3; d++)
-            sim->rhs[3 * i + d] =
-                sim->mass[i] * v_start[3 * i + d] + sim->half_dt * sim->force[3 * i + d];
+            sim->rhs[3 * i + d] = sim->mass[i] * v_start[3 * i + d] + sim->half_dt * f[d];
+    }
 }
 
 /* Copies 3 doubles per particle over the given ranges. */
@@ -194,8 +187,7 @@ static const double *stage_velocity_half(cs_sim *sim, const step_state *st)
         if (!sim->is_free[i])
             for (int d = 0; d < 3; d++)
                 sim->v0[3 * i + d] = (sim->script_x[3 * i + d] - sim->x[3 * i + d]) / st->dt;
-    explicit_forces(sim, sim->x); /* prepares the springs' directions at x^n too */
-    momentum_rhs(sim, sim->v);
+    explicit_forces(sim, sim->x, sim->v); /* prepares the springs' directions at x^n too */
     sim->cg_iterations += cs_cg_solve(sim, sim->v0, sim->rhs, sim->v_half, sim->cg.warm_half);
     return sim->v_half;
 }
@@ -210,7 +202,7 @@ static const double *stage_self_repulsion(cs_sim *sim, const step_state *st)
 /* B.3; without bodies, v*^n is v^n */
 static const double *stage_position_update(cs_sim *sim, const step_state *st)
 {
-    CS_FOR_OWNED(sim->par, i) {
+    CS_PARALLEL_FOR_OWNED(sim->par, i) {
         if (sim->is_free[i]) {
             for (int d = 0; d < 3; d++)
                 sim->x[3 * i + d] = sim->x_prev[3 * i + d] + st->dt * sim->v_half[3 * i + d];
@@ -243,11 +235,10 @@ static const double *stage_velocity_full(cs_sim *sim, const step_state *st)
     CS_FOR_OWNED(par, i)
         if (!sim->is_free[i])
             memcpy(sim->v_star + 3 * i, sim->v0 + 3 * i, 3 * sizeof(double));
-    CS_FOR_LOCAL(par, i) /* x^(n+1/2), reusing v_half */
+    CS_PARALLEL_FOR_LOCAL(par, i) /* x^(n+1/2), reusing v_half */
         for (int d = 0; d < 3; d++)
             sim->v_half[3 * i + d] = 0.5 * (sim->x_prev[3 * i + d] + sim->x[3 * i + d]);
-    explicit_forces(sim, sim->v_half); /* and at x^(n+1/2) */
-    momentum_rhs(sim, sim->v_star);
+    explicit_forces(sim, sim->v_half, sim->v_star); /* and at x^(n+1/2) */
     double *v_p = sim->v0; /* v0 is free again */
     copy_ranges(par->own, par->nown, sim->cg.b, sim->v_star);
     sim->cg_iterations += cs_cg_solve(sim, sim->cg.b, sim->rhs, v_p, sim->cg.warm_full);
@@ -255,7 +246,7 @@ static const double *stage_velocity_full(cs_sim *sim, const step_state *st)
         copy_ranges(par->local, par->nlocal, sim->v_next, sim->force);
         cs_halo_forward(par, &par->ghosts, v_p, 3);
         cs_damping_apply(sim, v_p, sim->v_next); /* F_i + F_d v_P */
-        CS_FOR_OWNED(par, i) {
+        CS_PARALLEL_FOR_OWNED(par, i) {
             for (int d = 0; d < 3; d++) {
                 int k = 3 * i + d;
                 double v_np = sim->v_star[k] + sim->half_dt / sim->mass[i] * sim->v_next[k];
@@ -264,7 +255,7 @@ static const double *stage_velocity_full(cs_sim *sim, const step_state *st)
             release_separating(sim, i, st->t1, v_p);
         }
     } else {
-        CS_FOR_OWNED(par, i)
+        CS_PARALLEL_FOR_OWNED(par, i)
             for (int d = 0; d < 3; d++)
                 sim->v_next[3 * i + d] = 2.0 * v_p[3 * i + d] - sim->v_star[3 * i + d];
     }
@@ -315,7 +306,7 @@ int cs_sim_step(cs_sim *sim, double dt)
     /* x (owned and ghosts) is current here; v only where owned */
     copy_ranges(par->local, par->nlocal, sim->x_prev, sim->x);
     release_scripts(sim, dt);
-    CS_FOR_OWNED(par, i)
+    CS_PARALLEL_FOR_OWNED(par, i)
         sim->mode[i] = sim->is_free[i] ? CS_FREE : CS_FIXED;
     cs_runaway_begin_step(sim, st.t1);
     for (size_t k = 0; k < sizeof STEP_STAGES / sizeof STEP_STAGES[0]; k++) {
