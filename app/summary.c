@@ -224,6 +224,7 @@ static cJSON *frame_json(const cs_summary *s, const cs_frame_record *f, builder 
         add_num(b, o, "collision_passes", (double)st->collision_passes);
         add_num(b, o, "impact_zones", (double)st->impact_zones);
         add_num(b, o, "max_zone_size", (double)st->max_zone_size);
+        add_num(b, o, "held_zones", (double)st->held_zones);
         add_num(b, o, "rewinds", (double)st->rewinds);
         add_num(b, o, "pair_searches", (double)st->pair_searches);
         add_num(b, o, "pair_traversals", (double)st->pair_traversals);

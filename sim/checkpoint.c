@@ -9,7 +9,9 @@
  *   bits of the result, depend on it);
  * - with self-collision, the collision-free positions x_free (step A's
  *   pairs and step C's trajectories start there; equal to x at a frame
- *   end, stored anyway so nothing is inferred).
+ *   end, stored anyway so nothing is inferred);
+ * - with scripts, how far each script's clock is behind (step C holds a
+ *   script back where an impact zone spans two of them).
  * Everything else is rewritten before it is read within a step or an outer
  * collision step, which never straddles a frame end: modes, contacts,
  * script targets, wind normals, spring directions, the preconditioner,
@@ -32,6 +34,8 @@ int cs_sim_state_arrays(cs_sim *sim, cs_state_array *a)
     a[k++] = (cs_state_array){"cg/warm_full", n3, sim->cg.warm_full};
     if (sim->selfcol)
         a[k++] = (cs_state_array){"self_collision/x_free", n3, sim->selfcol->x_free};
+    if (sim->nscripts > 0 && sim->script_lag)
+        a[k++] = (cs_state_array){"scripts/lag", (size_t)sim->nscripts, sim->script_lag};
     return k;
 }
 

@@ -62,6 +62,12 @@ struct cs_sim {
     int nscripts;
     cs_script_state *scripts;
     double *script_x, *script_v;  /* 3 per particle: targets at t^{n+1} */
+    int *script_of;               /* per particle: its script, or -1 */
+    /* per script: how far (s) its clock is behind the simulation's, after
+     * step C held it back (selfcol_collide.c), and the same at the outer
+     * step's start; a script behind runs at twice the speed until it is
+     * back on time (step.c's script_targets) */
+    double *script_lag, *script_lag_start;
     int nbodies;
     cs_body_def *bodies;          /* motion keys owned by the sim */
     cs_springs springs;           /* those this rank computes */

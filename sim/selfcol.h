@@ -36,6 +36,7 @@ typedef struct cs_selfcol_stats {
     long zones;                /* impact zones formed */
     long max_zone;             /* particles in the largest zone */
     long zones_across;         /* zone rigidifications spanning ranks */
+    long held_zones;           /* zones that spanned two scripts, held in place */
     long rewinds;              /* outer steps redone (rewind scheme) */
     long cache_searches;       /* searches of steps A and C (selfcol_cache.c) */
     long cache_builds;         /* of them, those that traversed the trees */

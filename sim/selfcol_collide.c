@@ -343,8 +343,49 @@ void cs_impact_zone_motion(int n, const int *idx, const double *m, const double 
     }
 }
 
+/* True when the zone's listed particles include vertices of two scripts
+ * (two pins, a pin and a script, two ends turning apart): no rigid motion
+ * keeps both on their paths. */
+static bool zone_spans_scripts(const cs_sim *sim, const int *list, int count)
+{
+    int first = -1;
+    for (int k = 0; k < count; k++) {
+        int i = list[k];
+        if (sim->is_free[i])
+            continue;
+        int s = sim->script_of[i];
+        if (first < 0)
+            first = s;
+        else if (s != first)
+            return true;
+    }
+    return false;
+}
+
+/* Script s back where it was at the outer step's start (its x_free, the
+ * pose at its clock then), all its vertices, and its clock with them: at
+ * the step's end it is span more behind. x_before keeps where step C puts
+ * a script's vertices, so a later rigid zone leaves them there too. */
+static void hold_script(cs_sim *sim, int s, double span)
+{
+    cs_selfcol *sc = sim->selfcol;
+    const cs_script_state *script = sim->scripts + s;
+    if (script->released)
+        return;
+    for (int j = 0; j < script->nvertices; j++) {
+        int i = script->vertices[j];
+        memcpy(sim->x + 3 * i, sc->x_free + 3 * i, 3 * sizeof(double));
+        memcpy(sc->x_before + 3 * i, sc->x_free + 3 * i, 3 * sizeof(double));
+        sc->vdirty[i] = 1;
+    }
+    sim->script_lag[s] = sim->script_lag_start[s] + span;
+}
+
 /* Moves every impact zone rigidly; pinned and scripted particles weigh
- * far more than the rest and keep their prescribed positions. */
+ * far more than the rest and keep their prescribed positions. A zone that
+ * holds vertices of two scripts cannot move rigidly with both; it stays
+ * where it was collision free, and so do those scripts (hold_script): they
+ * wait, then catch up (step.c's script_targets). */
 static void rigidify_zones(cs_sim *sim, double span, double *dv)
 {
     cs_selfcol *sc = sim->selfcol;
@@ -367,7 +408,18 @@ static void rigidify_zones(cs_sim *sim, double span, double *dv)
             if (sc->zone[i] >= 0 && sc_zone_find(sc->zone, i) == root)
                 sc->zone_list[count++] = i;
         double vcm[3], w[3];
-        cs_impact_zone_motion(count, sc->zone_list, mw, sc->x_free, u, span, sim->x, vcm, w);
+        bool hold = zone_spans_scripts(sim, sc->zone_list, count);
+        if (hold) {
+            for (int k = 0; k < count; k++) {
+                int i = sc->zone_list[k];
+                memcpy(sim->x + 3 * i, sc->x_free + 3 * i, 3 * sizeof(double));
+                if (!sim->is_free[i])
+                    hold_script(sim, sim->script_of[i], span);
+            }
+            sc->stats.held_zones++;
+        } else {
+            cs_impact_zone_motion(count, sc->zone_list, mw, sc->x_free, u, span, sim->x, vcm, w);
+        }
         for (int k = 0; k < count; k++) {
             int i = sc->zone_list[k];
             if (!sim->is_free[i])
@@ -537,11 +589,11 @@ long cs_selfcol_collide(cs_sim *sim, double span, int k, bool detect_only)
         }
         if (pass > d->zone_iterations + 1000) {
             /* cannot happen in exact arithmetic (zones only grow); stop
-             * the free particles at the collision-free state rather than
-             * loop forever */
-            for (int i = 0; i < n; i++)
-                if (sim->is_free[i])
-                    memcpy(x + 3 * i, sc->x_free + 3 * i, 3 * sizeof(double));
+             * every particle at the collision-free state rather than loop
+             * forever, the scripts too (their clocks wait) */
+            memcpy(x, sc->x_free, bytes);
+            for (int s = 0; s < sim->nscripts; s++)
+                hold_script(sim, s, span);
             break;
         }
     }

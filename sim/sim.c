@@ -275,9 +275,17 @@ int cs_sim_create_checked(const cs_sim_def *def, cs_sim **out, char *err, size_t
         sim->scripts = calloc((size_t)sim->nscripts, sizeof *sim->scripts);
         sim->script_x = alloc3(n);
         sim->script_v = alloc3(n);
-        if (!sim->scripts || !sim->script_x || !sim->script_v)
+        sim->script_of = malloc(sizeof *sim->script_of * ((size_t)n + 1));
+        sim->script_lag = calloc((size_t)sim->nscripts, sizeof *sim->script_lag);
+        sim->script_lag_start = calloc((size_t)sim->nscripts, sizeof *sim->script_lag_start);
+        if (!sim->scripts || !sim->script_x || !sim->script_v || !sim->script_of ||
+            !sim->script_lag || !sim->script_lag_start)
             goto nomem;
-        sim->stage_bytes[CS_STAGE_SCRIPTED_VERTICES] += 2 * 3 * sizeof(double) * (size_t)n;
+        for (int i = 0; i < n; i++)
+            sim->script_of[i] = -1;
+        sim->stage_bytes[CS_STAGE_SCRIPTED_VERTICES] +=
+            (2 * 3 * sizeof(double) + sizeof(int)) * (size_t)n +
+            2 * sizeof(double) * (size_t)sim->nscripts;
         int s = 0;
         for (int c = 0; c < def->ncloths; c++) {
             const cs_cloth_def *cl = def->cloths + c;
@@ -300,6 +308,7 @@ int cs_sim_create_checked(const cs_sim_def *def, cs_sim **out, char *err, size_t
                     int g = sim->cloths[c].offset + src->vertices[j];
                     double rel[3];
                     dst->vertices[j] = g;
+                    sim->script_of[g] = s;
                     cs_sub(sim->x + 3 * g, c0, rel);
                     cs_mat_apply_transpose(dst->rotation0, rel, dst->local + 3 * j);
                     sim->is_free[g] = 0;
@@ -443,6 +452,9 @@ void cs_sim_destroy(cs_sim *sim)
         free(arrays[k]);
     free(sim->is_free);
     free(sim->mode);
+    free(sim->script_of);
+    free(sim->script_lag);
+    free(sim->script_lag_start);
     free(sim->contact_body);
     free(sim);
 }

@@ -359,6 +359,7 @@ typedef struct cs_frame_stats {
     long collision_passes;     /* step C iterations */
     long impact_zones;         /* zones formed */
     long max_zone_size;        /* particles in the largest zone */
+    long held_zones;           /* zones spanning two scripts, held where collision free */
     long rewinds;              /* outer steps redone (rewind scheme) */
     long pair_searches;        /* searches of steps A and C */
     long pair_traversals;      /* of them, those that traversed the trees */

@@ -19,15 +19,28 @@
         (sim)->timing[stage].calls++;                                  \
     } while (0)
 
-/* Targets of scripted vertices at time t: position and velocity. */
-static void script_targets(cs_sim *sim, double t)
+/* A script that step C held back runs at this multiple of its speed until
+ * its clock is the simulation's again. */
+static const double CATCH_UP_RATE = 2.0;
+
+/* Targets of scripted vertices at the end t1 of a step of dt: position and
+ * velocity, at the script's own time t1 - lag (lag 0 but after a hold). */
+static void script_targets(cs_sim *sim, double t1, double dt)
 {
     for (int s = 0; s < sim->nscripts; s++) {
         cs_script_state *sc = sim->scripts + s;
         if (sc->released)
             continue;
+        double lag0 = sim->script_lag[s];
+        double lag1 = fmax(0.0, lag0 - (CATCH_UP_RATE - 1.0) * dt);
+        sim->script_lag[s] = lag1;
+        double t = t1 - lag1, rate = 1.0 + (lag0 - lag1) / dt; /* script s per s */
         double R[9], c[3], vel[3], w[3];
         cs_motion_pose(&sc->motion, t, R, c, vel, w);
+        for (int d = 0; d < 3; d++) {
+            vel[d] *= rate;
+            w[d] *= rate;
+        }
         for (int j = 0; j < sc->nvertices; j++) {
             int g = sc->vertices[j];
             double r[3], wr[3];
@@ -165,7 +178,7 @@ typedef const double *(*stage_fn)(cs_sim *sim, const step_state *st);
 
 static const double *stage_scripted_vertices(cs_sim *sim, const step_state *st)
 {
-    script_targets(sim, st->t1);
+    script_targets(sim, st->t1, st->dt);
     return NULL;
 }
 
@@ -342,6 +355,8 @@ static int outer_step(cs_sim *sim, int k)
     double t0 = sim->t;
     if (rewind) /* keep the start to come back to; x equals x_free here */
         memcpy(sim->v_rewind, sim->v, bytes);
+    if (sim->nscripts > 0) /* where a hold in step C sets the scripts' clocks back to */
+        memcpy(sim->script_lag_start, sim->script_lag, sizeof(double) * (size_t)sim->nscripts);
     for (;;) {
         STAGE_BEGIN(sim, CS_STAGE_REPULSION_PAIRS);
         cs_selfcol_find_pairs(sim, k * sim->dt);
@@ -356,6 +371,9 @@ static int outer_step(cs_sim *sim, int k)
             if (found > 0) {
                 memcpy(sim->x, sc->x_free, bytes);
                 memcpy(sim->v, sim->v_rewind, bytes);
+                if (sim->nscripts > 0)
+                    memcpy(sim->script_lag, sim->script_lag_start,
+                           sizeof(double) * (size_t)sim->nscripts);
                 sim->t = t0;
                 sc->stats.rewinds++;
                 /* the halves run one after another, each from its own start */
@@ -468,6 +486,7 @@ int cs_sim_advance_frame(cs_sim *sim, cs_frame_stats *stats)
             stats->collision_passes = self.passes - self0.passes;
             stats->impact_zones = self.zones - self0.zones;
             stats->max_zone_size = self.max_zone;
+            stats->held_zones = self.held_zones - self0.held_zones;
             stats->rewinds = self.rewinds - self0.rewinds;
             stats->pair_searches = self.cache_searches - self0.cache_searches;
             stats->pair_traversals = self.cache_builds - self0.cache_builds;
