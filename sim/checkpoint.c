@@ -34,7 +34,7 @@ int cs_sim_state_arrays(cs_sim *sim, cs_state_array *a)
     a[k++] = (cs_state_array){"cg/warm_full", n3, sim->cg.warm_full};
     if (sim->selfcol)
         a[k++] = (cs_state_array){"self_collision/x_free", n3, sim->selfcol->x_free};
-    if (sim->nscripts > 0 && sim->script_lag)
+    if (sim->nscripts > 0)
         a[k++] = (cs_state_array){"scripts/lag", (size_t)sim->nscripts, sim->script_lag};
     return k;
 }

@@ -365,12 +365,16 @@ static bool zone_spans_scripts(const cs_sim *sim, const int *list, int count)
 /* Script s back where it was at the outer step's start (its x_free, the
  * pose at its clock then), all its vertices, and its clock with them: at
  * the step's end it is span more behind. x_before keeps where step C puts
- * a script's vertices, so a later rigid zone leaves them there too. */
+ * a script's vertices, so a later rigid zone leaves them there too. Once
+ * per script and step C: a held script's lag is lag_start + span, which the
+ * steps' catching up (lag only shrinks from lag_start) never reaches, so a
+ * zone's other vertices of the same script find it held already. */
 static void hold_script(cs_sim *sim, int s, double span)
 {
     cs_selfcol *sc = sim->selfcol;
     const cs_script_state *script = sim->scripts + s;
-    if (script->released)
+    double held_lag = sim->script_lag_start[s] + span;
+    if (script->released || sim->script_lag[s] == held_lag)
         return;
     for (int j = 0; j < script->nvertices; j++) {
         int i = script->vertices[j];
@@ -378,7 +382,7 @@ static void hold_script(cs_sim *sim, int s, double span)
         memcpy(sc->x_before + 3 * i, sc->x_free + 3 * i, 3 * sizeof(double));
         sc->vdirty[i] = 1;
     }
-    sim->script_lag[s] = sim->script_lag_start[s] + span;
+    sim->script_lag[s] = held_lag;
 }
 
 /* Moves every impact zone rigidly; pinned and scripted particles weigh

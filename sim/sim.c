@@ -254,12 +254,11 @@ int cs_sim_create_checked(const cs_sim_def *def, cs_sim **out, char *err, size_t
         memcpy(cs->mesh->tri, m->tri, sizeof *m->tri * 3 * (size_t)m->nt);
         memcpy(sim->x + 3 * offset, m->x, sizeof *m->x * 3 * (size_t)m->nv);
         cloth_masses(cl, sim->mass + offset);
-        if (sim->cg.inv_mass) /* not with plan_only */
-            for (int i = 0; i < m->nv; i++)
-                sim->cg.inv_mass[offset + i] = 1.0 / sim->mass[offset + i];
         for (int i = 0; i < m->nv; i++) {
             memcpy(sim->v + 3 * (offset + i), cl->velocity, 3 * sizeof(double));
             sim->is_free[offset + i] = 1;
+            if (sim->cg.inv_mass) /* not with plan_only */
+                sim->cg.inv_mass[offset + i] = 1.0 / sim->mass[offset + i];
         }
         /* springs hold global particle indices into x and mass */
         if (cs_springs_add_mesh(&sim->springs, offset, m->nv, m->nt, m->tri, sim->x, sim->mass,
