@@ -173,7 +173,7 @@ int cs_levelset_main(int argc, char **argv)
     rep = sign_rep;
     bool given = voxel > 0, fill;
     char why[512];
-    if (!cs_mesh_body_grid(&rep, &voxel, 0, band, interior, &fill, why, sizeof why)) {
+    if (!cs_mesh_body_grid(&rep, &voxel, 0, 0, &band, interior, &fill, why, sizeof why)) {
         fprintf(stderr, "clothsim levelset: %s %g m: %s\n", given ? "--voxel" : "the default voxel",
                 voxel, why);
         cs_trimesh_destroy(mesh);

@@ -53,14 +53,22 @@ cs_trimesh *cs_mesh_body_sign_mesh(cs_trimesh *mesh, const cs_mesh_report *rep, 
     return sign;
 }
 
-bool cs_mesh_body_grid(const cs_mesh_report *mesh, double *voxel, double cloth_edge, double band,
-                       cs_interior_mode interior, bool *fill, char *why, size_t len)
+double cs_levelset_grid_band(double band, double offset, double voxel)
+{
+    /* the 1e-9 keeps an offset of a whole number of voxels from rounding up */
+    return offset > 0 && voxel > 0 ? band + ceil(offset / voxel - 1e-9) : band;
+}
+
+bool cs_mesh_body_grid(const cs_mesh_report *mesh, double *voxel, double cloth_edge, double offset,
+                       double *band, cs_interior_mode interior, bool *fill, char *why,
+                       size_t len)
 {
     if (!(*voxel > 0))
-        *voxel = cs_levelset_default_voxel(mesh, cloth_edge, band, interior == CS_INTERIOR_FILL);
+        *voxel = cs_levelset_default_voxel(mesh, cloth_edge, *band, interior == CS_INTERIOR_FILL);
+    *band = cs_levelset_grid_band(*band, offset, *voxel);
     *fill = interior == CS_INTERIOR_AUTO ? cs_levelset_auto_fill(mesh, *voxel)
                                          : interior == CS_INTERIOR_FILL;
-    return cs_levelset_voxel_ok(mesh, *voxel, band, *fill, why, len);
+    return cs_levelset_voxel_ok(mesh, *voxel, *band, *fill, why, len);
 }
 
 /* mesh.scale: one number (uniform) or three, each > 0. Read from the
@@ -372,8 +380,10 @@ int cs_sl_finish_mesh_bodies(loader *L, cs_scene *s)
         bool given = mb->voxel_size > 0;
         if (!given && edge < 0)
             edge = cloth_edge_median(&s->def);
-        if (!cs_mesh_body_grid(&closed, &mb->voxel_size, edge, mb->band, mb->interior,
-                               &mb->fill_interior, why, sizeof why)) {
+        mb->grid_band = mb->band;
+        if (!cs_mesh_body_grid(&closed, &mb->voxel_size, edge, s->def.bodies[b].offset,
+                               &mb->grid_band, mb->interior, &mb->fill_interior, why,
+                               sizeof why)) {
             snprintf(p, sizeof p, "%s%s", base, given ? ".voxel_size" : "");
             if (given)
                 return cs_sl_fail(L, p, true, "%s", why);
@@ -402,7 +412,7 @@ int cs_sl_build_levelsets(loader *L, cs_scene *s)
         snprintf(who, sizeof who, "bodies[%d] '%.60s'", b, s->def.bodies[b].name);
         cs_levelset_request req = {
             .voxel_size = mb->voxel_size,
-            .band = mb->band,
+            .band = mb->grid_band,
             .fill_interior = mb->fill_interior,
             .cache_dir = s->levelset_cache,
             .label = stem,
@@ -435,7 +445,7 @@ int cs_sl_build_levelsets(loader *L, cs_scene *s)
         if (!cs_sl_note(s,
                         "%s: level set %dx%dx%d voxels of %.3g m (band %g%s), %lld active, "
                         "%.1f MB; %s",
-                        who, info.dim[0], info.dim[1], info.dim[2], info.voxel_size, mb->band,
+                        who, info.dim[0], info.dim[1], info.dim[2], info.voxel_size, mb->grid_band,
                         mb->fill_interior ? ", interior filled" : "", info.active_voxels,
                         info.memory_bytes / 1e6, done))
             return CS_IMPORT_NOMEM;

@@ -158,11 +158,11 @@ static void test_relative_path(void **state)
 
 /* -------------------------------------------------------------- bodies */
 
-static void test_mesh_body(void **state)
+/* A scene with one mesh body, the unit sphere of ico4.obj centred at
+ * (0, 1, 0), with the body keys in keys (indented lines). */
+static void ball_scene(char *text, size_t size, const char *keys)
 {
-    (void)state;
-    char text[2048];
-    snprintf(text, sizeof text,
+    snprintf(text, size,
              GRID "bodies:\n"
                   "  - name: ball\n"
                   "    shape: mesh\n"
@@ -170,11 +170,16 @@ static void test_mesh_body(void **state)
                   "      file: %s\n"
                   "      translate: [-0.240, -0.180, -0.898]\n"
                   "    position: [0, 1, 0]\n"
-                  "    voxel_size: 0.1\n"
-                  "    band: 2\n"
-                  "    friction: 0.6\n"
+                  "%s"
                   "levelset: {cache: %s/cache}\n",
-             ASSET("ico4.obj"), tmpdir);
+             ASSET("ico4.obj"), keys, tmpdir);
+}
+
+static void test_mesh_body(void **state)
+{
+    (void)state;
+    char text[2048];
+    ball_scene(text, sizeof text, "    voxel_size: 0.1\n    band: 2\n    friction: 0.6\n");
     cs_scene *s = load_ok(text, 0, NULL);
     const cs_body_def *b = &s->def.bodies[0];
     const cs_scene_mesh_body *mb = &s->mesh_bodies[0];
@@ -220,6 +225,36 @@ static void test_mesh_body(void **state)
     assert_null(s->mesh_bodies[0].cache_path);
     double inside[3] = {0.1, 0.1, 0.1};
     assert_true(cs_body_def_phi(&s->def.bodies[0], 0, inside, g) < 0);
+    cs_scene_destroy(s);
+}
+
+/* A collision offset wider than the narrow band: the grid reaches band
+ * voxels past the offset surface, so collisions (phi - offset) read true
+ * distances there. With the band alone (2 voxels of 0.05 m) phi read 0.1
+ * beyond 0.1 m, and a point 0.25 m out was 0.05 m inside the 0.3 m offset
+ * surface: B.4 moved such particles onto it in one step (the wardrobe at
+ * 100,352 triangles: an 18 mm jump, then a runaway). */
+static void test_offset_beyond_band(void **state)
+{
+    (void)state;
+    char text[2048];
+    ball_scene(text, sizeof text, "    voxel_size: 0.05\n    band: 2\n    collision_offset: 0.3\n");
+    cs_scene *s = load_ok(text, 0, NULL);
+    const cs_body_def *b = &s->def.bodies[0];
+    const cs_scene_mesh_body *mb = &s->mesh_bodies[0];
+    assert_true(fabs(mb->band - 2) < 1e-12);
+    assert_true(fabs(mb->grid_band - 8) < 1e-12); /* 2 + 0.3 / 0.05 */
+    assert_true(has_note(s, "(band 8"));
+    /* the unit sphere at (0, 1, 0): points 0.25 m and 0.4 m out read their
+     * distance (within a voxel's chord error), inside and outside the
+     * offset surface respectively */
+    double g[3], p1[3] = {0, 2.25, 0}, p2[3] = {0.4 + 1, 1, 0};
+    double phi1 = cs_body_def_phi(b, 0, p1, g), phi2 = cs_body_def_phi(b, 0, p2, g);
+    assert_true(fabs(phi1 - 0.25) < 0.02);
+    assert_true(phi1 - b->offset < 0);
+    assert_true(fabs(phi2 - 0.4) < 0.02);
+    assert_true(phi2 - b->offset > 0);
+    assert_true(g[0] > 0.99);
     cs_scene_destroy(s);
 }
 
@@ -381,6 +416,7 @@ int main(void)
         cmocka_unit_test(test_cloth_from_file),
         cmocka_unit_test(test_relative_path),
         cmocka_unit_test(test_mesh_body),
+        cmocka_unit_test(test_offset_beyond_band),
         cmocka_unit_test(test_open_body_warns),
         cmocka_unit_test(test_default_voxel),
         cmocka_unit_test(test_override_scale),
