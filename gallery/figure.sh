@@ -53,7 +53,9 @@
 #         the two runs instead of their last frames (e.g. where both are still
 #         in view), as FIGURE_COMPARE_FRAME=N does
 #
-# Environment: BUILD (default build, a Release build), FIGURE_SIM_ONLY=1
+# Environment: BUILD (default build, a Release build), FIGURE_RESUME=1 (go
+# on with an interrupted run in out/figures/NAME/run: `clothsim run
+# --resume`, same options; the pictures are all remade), FIGURE_SIM_ONLY=1
 # (the run and its Table 3 row, no pictures, nothing copied), FIGURE_RUN_ARGS (more
 # `clothsim run` options, e.g. "--frames 12" while developing),
 # FIGURE_STILL_SIZE/_SAMPLES, FIGURE_ANIM_SIZE/_SAMPLES (image size and
@@ -107,10 +109,19 @@ else
 fi
 
 OUT=out/figures/$NAME
-rm -rf "$OUT"
-mkdir -p "$OUT"
 LOG=$OUT/commands.txt
-: >"$LOG"
+# FIGURE_RESUME=1 continues an interrupted run (a gallery size takes hours)
+# with `clothsim run --resume` and remakes everything else; the run's peak
+# memory is then the resumed process's.
+RESUME=
+if [ -n "${FIGURE_RESUME:-}" ] && [ -f "$OUT/run/state.h5" ]; then
+    RESUME=--resume
+    find "$OUT" -mindepth 1 -maxdepth 1 ! -name run ! -name commands.txt -exec rm -rf {} +
+else
+    rm -rf "$OUT"
+    mkdir -p "$OUT"
+    : >"$LOG"
+fi
 
 # quoted ARGS...: the arguments as a shell reads them back (quoted where needed).
 quoted() {
@@ -202,7 +213,7 @@ EOF
 }
 
 # shellcheck disable=SC2086
-simulate "$OUT/run" $SIZE_ARGS ${FIGURE_RUN_ARGS:-} || {
+simulate "$OUT/run" $SIZE_ARGS ${FIGURE_RUN_ARGS:-} $RESUME || {
     rc=$?
     tail -n 5 "$OUT/run.log" >&2
     echo "figure.sh: the simulation of $NAME failed (exit $rc)" >&2
