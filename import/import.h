@@ -256,21 +256,13 @@ cs_trimesh *cs_mesh_body_sign_mesh(cs_trimesh *mesh, const cs_mesh_report *rep, 
 
 /* The grid of a mesh body: *voxel as given (> 0), else the default for
  * cloth_edge (see cs_levelset_default_voxel); *fill as interior says (auto:
- * cs_levelset_auto_fill); *band the band the grid needs, in voxels: the
- * scene's band beyond the collision surface, which lies offset (m) out from
- * the mesh (see cs_levelset_grid_band). False, with a phrase in why, when
- * the voxel size does not suit the mesh (cs_levelset_voxel_ok). */
+ * cs_levelset_auto_fill); *band, given as the scene's band beyond the
+ * collision surface (offset m out from the mesh), becomes the band the grid
+ * needs, in voxels. False, with a phrase in why, when the voxel size does
+ * not suit the mesh (cs_levelset_voxel_ok). */
 bool cs_mesh_body_grid(const cs_mesh_report *mesh, double *voxel, double cloth_edge, double offset,
                        double *band, cs_interior_mode interior, bool *fill, char *why,
                        size_t len);
-
-/* The narrow band (voxels) a grid needs so that collisions, which see
- * phi - offset, read true distances for band voxels beyond the offset
- * surface: band + ceil(offset / voxel). Beyond its band a grid reads the
- * band's width, so a band narrower than the offset would put every point
- * past it inside the collision surface, and B.4 would move such a particle
- * onto it in one step. */
-double cs_levelset_grid_band(double band, double offset, double voxel);
 
 /* ------------------------------------------------------------- scenes */
 
@@ -294,7 +286,7 @@ typedef struct cs_scene_mesh_body {
     double band;               /* narrow band beyond the collision offset,
                                   voxels (the scene's `band`) */
     double grid_band;          /* the grid's band: band plus the offset in
-                                  voxels (cs_levelset_grid_band) */
+                                  voxels (cs_mesh_body_grid) */
     cs_interior_mode interior; /* as the scene asked */
     bool fill_interior;        /* as decided: distances all the way in */
     bool close_holes;

@@ -53,9 +53,15 @@ cs_trimesh *cs_mesh_body_sign_mesh(cs_trimesh *mesh, const cs_mesh_report *rep, 
     return sign;
 }
 
-double cs_levelset_grid_band(double band, double offset, double voxel)
+/* The narrow band (voxels) a grid needs so that collisions, which see
+ * phi - offset, read true distances for band voxels beyond the offset
+ * surface. Beyond its band a grid reads the band's width, so a band
+ * narrower than the offset would put every point past it inside the
+ * collision surface, and B.4 would move such a particle onto it in one
+ * step. The 1e-9 keeps an offset of a whole number of voxels from rounding
+ * up. */
+static double grid_band(double band, double offset, double voxel)
 {
-    /* the 1e-9 keeps an offset of a whole number of voxels from rounding up */
     return offset > 0 && voxel > 0 ? band + ceil(offset / voxel - 1e-9) : band;
 }
 
@@ -65,7 +71,7 @@ bool cs_mesh_body_grid(const cs_mesh_report *mesh, double *voxel, double cloth_e
 {
     if (!(*voxel > 0))
         *voxel = cs_levelset_default_voxel(mesh, cloth_edge, *band, interior == CS_INTERIOR_FILL);
-    *band = cs_levelset_grid_band(*band, offset, *voxel);
+    *band = grid_band(*band, offset, *voxel);
     *fill = interior == CS_INTERIOR_AUTO ? cs_levelset_auto_fill(mesh, *voxel)
                                          : interior == CS_INTERIOR_FILL;
     return cs_levelset_voxel_ok(mesh, *voxel, *band, *fill, why, len);
