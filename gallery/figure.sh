@@ -51,7 +51,8 @@
 #         (rolling_cloth compares with the previous friction method, Fig. 7,
 #         even without the line); a first word frame=N compares frame N of
 #         the two runs instead of their last frames (e.g. where both are still
-#         in view), as FIGURE_COMPARE_FRAME=N does
+#         in view), as FIGURE_COMPARE_FRAME=N does, and the second run stops
+#         at frame N
 #
 # Environment: BUILD (default build, a Release build), FIGURE_RESUME=1 (go
 # on with an interrupted run in out/figures/NAME/run: `clothsim run
@@ -269,8 +270,11 @@ HAVE_FFMPEG=
 command -v ffmpeg >/dev/null 2>&1 && HAVE_FFMPEG=1
 if [ -n "$COMPARE_ARGS" ]; then
     crc=0
+    # a comparison at frame=N needs only N frames of its run
+    CRUN_FRAMES=
+    [ -n "$COMPARE_FRAME" ] && CRUN_FRAMES="--frames $COMPARE_FRAME"
     # shellcheck disable=SC2086
-    simulate "$OUT/compare" $SIZE_ARGS ${FIGURE_RUN_ARGS:-} $COMPARE_ARGS || crc=$?
+    simulate "$OUT/compare" $SIZE_ARGS ${FIGURE_RUN_ARGS:-} $COMPARE_ARGS $CRUN_FRAMES || crc=$?
     if [ "$crc" -ne 0 ] && [ "$crc" -ne 3 ]; then
         tail -n 5 "$OUT/compare.log" >&2
         echo "figure.sh: the comparison run ($COMPARE_ARGS) failed (exit $crc)" >&2
