@@ -6,7 +6,7 @@
  * function of the scene and the time only, the same on every rank and after
  * a resume):
  *
- *   limit(t) = 10 (v0 + |g| t + body(t) + script(t) + |wind|) + c / 4 + 1 m/s
+ *   limit(t) = 10 (v0 + |g| t + body(t) + script(t) + |wind| + |boost|) + c / 4 + 1 m/s
  *
  * v0 the fastest initial velocity; |g| t what gravity can give since the
  * start; body(t) and script(t) the fastest surface point of a moving body
@@ -66,7 +66,7 @@ double cs_runaway_limit(const cs_sim *sim, double t)
 {
     double drive = sim->runaway.initial_speed + cs_norm(sim->def.gravity) * fabs(t);
     if (sim->def.wind_enabled)
-        drive += cs_norm(sim->def.wind.velocity);
+        drive += cs_norm(sim->def.wind.velocity) + cs_norm(sim->def.wind.ground_boost);
     for (int s = 0; s < sim->nscripts; s++)
         drive += motion_speed(&sim->scripts[s].motion, t, sim->scripts[s].radius);
     for (int b = 0; b < sim->nbodies; b++) {

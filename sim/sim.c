@@ -52,6 +52,7 @@ cs_sim_def cs_default_sim_def(void)
     d.friction_method = CS_FRICTION_IMPROVED;
     d.bodies_enabled = true;
     d.wind_enabled = false;
+    d.wind.ground_height = 1;
     d.self = cs_default_self_collision_def();
     d.comm = CS_COMM_WORLD;
     return d;
@@ -99,8 +100,10 @@ static int validate(const cs_sim_def *def, char *err, size_t errlen)
         return fail(err, errlen, "collision_steps, cg_tolerance and cg_max_iterations must be positive");
     if (!finite3(def->gravity))
         return fail(err, errlen, "gravity must be finite");
-    if (!(def->wind.drag >= 0) || !finite3(def->wind.velocity))
-        return fail(err, errlen, "wind drag must be >= 0 and its velocity finite");
+    if (!(def->wind.drag >= 0) || !finite3(def->wind.velocity) || !finite3(def->wind.ground_boost))
+        return fail(err, errlen, "wind drag must be >= 0 and its velocities finite");
+    if (!(def->wind.ground_height > 0) || !isfinite(def->wind.ground_height))
+        return fail(err, errlen, "wind ground_height must be > 0 and finite");
     for (int c = 0; c < def->ncloths; c++) {
         const cs_cloth_def *cl = def->cloths + c;
         const cs_cloth_material *m = &cl->material;

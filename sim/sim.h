@@ -234,12 +234,26 @@ typedef enum cs_friction_method {
 } cs_friction_method;
 
 /* Linear drag along the normal (Section 8): each vertex feels
- * F = -drag * area_i * ((v - wind) . n) n, with area_i a third of the area
- * of its triangles, so drag has units N s / m^3. */
+ * F = -drag * area_i * ((v - wind(y)) . n) n, with area_i a third of the
+ * area of its triangles, so drag has units N s / m^3. The paper keeps "a
+ * high wind speed near the ground" for its falling leaves:
+ * wind(y) = velocity + ground_boost * max(0, 1 - y / ground_height), so the
+ * wind differs across a leaf and turns and bends it. */
 typedef struct cs_wind_def {
     double velocity[3];
     double drag;
+    double ground_boost[3];  /* added at y <= 0, fading to 0 at ground_height */
+    double ground_height;    /* m, > 0 (default 1) */
 } cs_wind_def;
+
+/* The wind at height y (the +y axis is up in every scene). */
+static inline void cs_wind_at(const cs_wind_def *w, double y, double out[3])
+{
+    double f = 1 - y / w->ground_height;
+    f = f < 0 ? 0 : f > 1 ? 1 : f;
+    for (int d = 0; d < 3; d++)
+        out[d] = w->velocity[d] + f * w->ground_boost[d];
+}
 
 /* Self-collision (Sections 4 and 5). Defaults from Table 1. */
 typedef enum cs_collision_scheme {

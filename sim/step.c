@@ -126,7 +126,9 @@ static void explicit_forces(cs_sim *sim, const double *x, const double *v_start)
         cs_axpy(sim->mass[i], sim->def.gravity, f);
         if (sim->wind_normal) {
             const double *nrm = sim->wind_normal + 3 * i;
-            cs_axpy(c * sim->wind_area[i] * cs_dot(nrm, sim->def.wind.velocity), nrm, f);
+            double wind[3];
+            cs_wind_at(&sim->def.wind, x[3 * i + 1], wind);
+            cs_axpy(c * sim->wind_area[i] * cs_dot(nrm, wind), nrm, f);
         }
         for (int d = 0; d < 3; d++)
             sim->rhs[3 * i + d] = sim->mass[i] * v_start[3 * i + d] + sim->half_dt * f[d];
