@@ -649,6 +649,20 @@ int cs_run_main(int argc, char **argv)
         goto done;
     }
 
+    /* The verifier counts at each frame's end; a cloth that already
+     * intersects at the start (cloths placed through each other) would show
+     * as pairs at frame 1 with no word of why, and history-based collisions
+     * keep such pairs rather than separate them. */
+    if (root && !o.resume && scene->def.self_collision && scene->def.self.verify) {
+        long start_pairs = cs_sim_count_intersections(r.sim);
+        if (start_pairs > 0)
+            fprintf(stderr,
+                    "clothsim: warning: %s: the cloth starts with %ld intersecting triangle "
+                    "pairs; self-collision keeps them (it prevents crossings, it does not "
+                    "undo them): move the cloths apart\n",
+                    scene->path, start_pairs);
+    }
+
     int ncloths = cs_sim_cloth_count(r.sim);
     r.views = calloc(ncloths > 0 ? (size_t)ncloths : 1, sizeof *r.views);
     if (cs_outdir_init(&r.out, o.out_dir, scene->name) != 0 || !r.views) {
