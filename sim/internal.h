@@ -22,6 +22,10 @@ typedef struct cs_script_state {
     bool released;
 } cs_script_state;
 
+/* A script that step C held back runs at this multiple of its speed until
+ * its clock is the simulation's again (step.c; runaway.c bounds it). */
+static const double CS_SCRIPT_CATCH_UP_RATE = 2.0;
+
 /* runaway.c: what instability detection knows (see there). */
 typedef struct cs_runaway {
     double initial_speed, wave_speed; /* from the scene, fixed at creation */

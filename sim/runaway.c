@@ -2,15 +2,16 @@
  *
  * A blow-up of the explicit elastic forces, a solve gone astray or a
  * collision response that adds energy all show as cloth moving far faster
- * than anything in the scene can drive it. The bound is history-free (a
- * function of the scene and the time only, the same on every rank and after
- * a resume):
+ * than anything in the scene can drive it. The bound is a function of the
+ * scene, the time and the scripts' lag (state every rank shares and a resume
+ * restores), so it is the same on every rank and after a resume:
  *
  *   limit(t) = 10 (v0 + |g| t + body(t) + script(t) + |wind| + |boost|) + c / 4 + 1 m/s
  *
  * v0 the fastest initial velocity; |g| t what gravity can give since the
  * start; body(t) and script(t) the fastest surface point of a moving body
- * or a scripted vertex set now (|v| + |w| r over its extent); c the fastest
+ * or a scripted vertex set so far (cloth keeps what a driver gave it after
+ * the driver stops; a held script's at its own, lagging clock) (|v| + |w| r over its extent); c the fastest
  * elastic wave, sqrt(E L0 / m) over the edge springs: a stretch of strain e
  * released sends its ends back at e c, and cloth that was stretched by a
  * quarter is far beyond Table 1's (stiff cloth, c of hundreds of m/s). The factor 10 leaves room for
@@ -62,13 +63,36 @@ static double motion_speed(const cs_motion *m, double t, double r)
     return cs_norm(vel) + cs_norm(w) * r;
 }
 
+/* The fastest point within r of the motion's centre at any time up to t:
+ * cloth keeps the speed a driver gave it after the driver stops (a twist
+ * whose ends halt whips on), so the bound must not drop when the keys end.
+ * Keys are linear in position and slerped in rotation, so a segment's
+ * speed is its midpoint's. */
+static double motion_speed_so_far(const cs_motion *m, double t, double r)
+{
+    double fastest = motion_speed(m, t, r);
+    if (m->kind == CS_MOTION_KEYFRAMES)
+        for (int k = 0; k + 1 < m->nkeys && m->keys[k].time < t; k++)
+            fastest = fmax(fastest,
+                           motion_speed(m, 0.5 * (m->keys[k].time + m->keys[k + 1].time), r));
+    return fastest;
+}
+
 double cs_runaway_limit(const cs_sim *sim, double t)
 {
     double drive = sim->runaway.initial_speed + cs_norm(sim->def.gravity) * fabs(t);
     if (sim->def.wind_enabled)
         drive += cs_norm(sim->def.wind.velocity) + cs_norm(sim->def.wind.ground_boost);
-    for (int s = 0; s < sim->nscripts; s++)
-        drive += motion_speed(&sim->scripts[s].motion, t, sim->scripts[s].radius);
+    /* a script step C held back runs behind its keys (its lag, the same on
+     * every rank and restored on resume) and catches up faster: its speed
+     * then is that of its own clock, times the catch-up rate. Taking the
+     * keys' time instead dropped the bound to the wave term alone when the
+     * keys ended while a held twist was still catching up. */
+    for (int s = 0; s < sim->nscripts; s++) {
+        double lag = sim->script_lag[s];
+        drive += motion_speed_so_far(&sim->scripts[s].motion, t - lag, sim->scripts[s].radius) *
+                 (lag > 0 ? CS_SCRIPT_CATCH_UP_RATE : 1.0);
+    }
     for (int b = 0; b < sim->nbodies; b++) {
         const cs_body_def *body = sim->bodies + b;
         double c[3], w[3], lo[3], hi[3], r = 0;
@@ -84,7 +108,7 @@ double cs_runaway_limit(const cs_sim *sim, double t)
                 r = fmax(r, cs_norm(d));
             }
         }
-        drive += motion_speed(&body->motion, t, r);
+        drive += motion_speed_so_far(&body->motion, t, r);
     }
     return SPEED_FACTOR * drive + RELEASED_STRAIN * sim->runaway.wave_speed + SPEED_FLOOR;
 }

@@ -19,10 +19,6 @@
         (sim)->timing[stage].calls++;                                  \
     } while (0)
 
-/* A script that step C held back runs at this multiple of its speed until
- * its clock is the simulation's again. */
-static const double CATCH_UP_RATE = 2.0;
-
 /* Targets of scripted vertices at the end t1 of a step of dt: position and
  * velocity, at the script's own time t1 - lag (lag 0 but after a hold). */
 static void script_targets(cs_sim *sim, double t1, double dt)
@@ -32,7 +28,7 @@ static void script_targets(cs_sim *sim, double t1, double dt)
         if (sc->released)
             continue;
         double lag0 = sim->script_lag[s];
-        double lag1 = fmax(0.0, lag0 - (CATCH_UP_RATE - 1.0) * dt);
+        double lag1 = fmax(0.0, lag0 - (CS_SCRIPT_CATCH_UP_RATE - 1.0) * dt);
         sim->script_lag[s] = lag1;
         double t = t1 - lag1, rate = 1.0 + (lag0 - lag1) / dt; /* script s per s */
         double R[9], c[3], vel[3], w[3];

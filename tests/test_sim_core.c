@@ -543,6 +543,51 @@ static void test_impossible_steps_are_refused(void **state)
     cs_trimesh_destroy(mesh);
 }
 
+/* The runaway bound follows what drives the cloth: cloth keeps the speed a
+ * script gave it after the script stops, and a script step C held back
+ * catches up at twice its speed. A twist whose ends stop at their last key
+ * (tests/data/scenes/twist_jam.yaml) whipped at 16.8 m/s a step later and
+ * was called unstable: the bound had dropped from 10 times the ends' speed
+ * to the wave term alone. */
+static void test_runaway_bound_keeps_what_scripts_gave(void **state)
+{
+    (void)state;
+    double size[2] = {1, 1}, q[4] = {1, 0, 0, 0}, c[3] = {0, 0, 0};
+    int res[2] = {4, 4};
+    int corners[2] = {0, 4};
+    /* the pinned corners move 1 m along x in 0.5 s (2 m/s), then stop */
+    cs_keyframe keys[2] = {{0, {0, 0, 0}, {1, 0, 0, 0}}, {0.5, {1, 0, 0}, {1, 0, 0, 0}}};
+    cs_motion motion = cs_motion_static();
+    motion.kind = CS_MOTION_KEYFRAMES;
+    motion.nkeys = 2;
+    motion.keys = keys;
+    cs_vertex_script pin = {2, corners, motion, 0};
+    cs_trimesh *mesh = cs_trimesh_create_grid(size, res, q, c);
+    cs_cloth_def cloth = {.name = "c", .mesh = mesh, .material = cs_default_cloth_material(),
+                          .nscripts = 1, .scripts = &pin};
+    cs_sim_def def = cs_default_sim_def();
+    def.ncloths = 1;
+    def.cloths = &cloth;
+    def.gravity[0] = def.gravity[1] = def.gravity[2] = 0;
+    char err[512];
+    cs_sim *sim = NULL;
+    assert_int_equal(cs_sim_create_checked(&def, &sim, err, sizeof err), CS_OK);
+    /* at t = 0 the script has not moved yet (a motion is still before its
+     * first key): the terms without it */
+    double still = cs_runaway_limit(sim, 0);
+    assert_true(still > 0);
+    /* the script's speed is 2 m/s plus nothing turning: 10 x 2 while it
+     * moves, and still after its last key */
+    assert_true(fabs(cs_runaway_limit(sim, 0.25) - (still + 20)) < 1e-9);
+    assert_true(fabs(cs_runaway_limit(sim, 2.0) - (still + 20)) < 1e-9);
+    /* held 0.3 s behind: at t = 0.6 its clock reads 0.3, inside the keys,
+     * and it catches up at 4 m/s */
+    sim->script_lag[0] = 0.3;
+    assert_true(fabs(cs_runaway_limit(sim, 0.6) - (still + 40)) < 1e-9);
+    cs_sim_destroy(sim);
+    cs_trimesh_destroy(mesh);
+}
+
 /* Far past the stability limit the explicit elastic forces grow
  * geometrically: 91 times the undamped limit (the one step per frame that
  * time.dt: 1e-12 used to become) must be caught early (the issue saw the
@@ -770,6 +815,7 @@ int main(void)
         cmocka_unit_test(test_automatic_dt_is_stable_across_resolutions),
         cmocka_unit_test(test_impossible_steps_are_refused),
         cmocka_unit_test(test_runaway_is_detected_with_its_stage),
+        cmocka_unit_test(test_runaway_bound_keeps_what_scripts_gave),
         cmocka_unit_test(test_wind_drag_terminal_velocity),
         cmocka_unit_test(test_moving_body_drags_particle),
         cmocka_unit_test(test_scripted_vertices_follow_keys),
