@@ -174,8 +174,8 @@ static double reduce(cs_sim *sim, const double *sum, const double *max, double *
                                              ? r0 + CS_BLOCK : (sim)->par->nowned;   \
              r0 < r1; r0 = r1)
 
-/* v0 is read on the ghosts (after a refresh here); v is written where
- * owned. The stopping test is the residual in velocity units, max over
+/* v0 is read and v written where owned (y, the start, is sent to the
+ * ghosts). The stopping test is the residual in velocity units, max over
  * particles of |r_i| / m_i: a maximum is exact, so every rank and thread
  * count stops at the same iteration. */
 int cs_cg_solve(cs_sim *sim, double *v0, const double *rhs, double *v, double *warm)
@@ -186,29 +186,24 @@ int cs_cg_solve(cs_sim *sim, double *v0, const double *rhs, double *v, double *w
     const cs_springs *s = &sim->springs;
     double *part_sum = w->partial, *part_max = w->partial + block_count(par);
 
-    /* Start from the explicit update z = P M^-1 r0, exact when the damping
-     * does no work (rigid motion). Starting from z = 0 would let a loose
-     * tolerance (Table 1's 1e-3 m/s) swallow a step's whole acceleration
-     * when dt is small: the solve must resolve only the damping response.
-     * With warm, add the damping response of this solve's previous call
-     * (projected by today's contacts): it changes little from one step to
-     * the next, so CG starts near the answer (the stopping test is the
-     * same, only fewer iterations reach it). The same pass over the springs
-     * builds the block Jacobi preconditioner. */
-    cs_halo_forward(par, &par->ghosts, v0, 3);
+    /* Start from the explicit update z = P M^-1 (rhs - M v0): gravity
+     * and the elastic forces, exact when the damping does no work (rigid
+     * motion). Starting from z = 0 would let a loose tolerance (Table 1's
+     * 1e-3 m/s) swallow a step's whole acceleration when dt is small: the
+     * solve must resolve only the damping response. With warm, add the
+     * damping response of this solve's previous call (projected by today's
+     * contacts): it changes little from one step to the next, so CG starts
+     * near the answer (the stopping test is the same, only fewer
+     * iterations reach it). The explicit update leaves the damping out so
+     * that it needs no pass over the springs: the one pass below takes the
+     * residual and builds the block Jacobi preconditioner from the same
+     * directions (two passes before; the warm start carries the damping). */
 #pragma omp parallel for schedule(static)
     for (int r = 0; r < par->nowned; r++) {
         int i = own[r];
-        double acc[3] = {0, 0, 0}, B[6];
-        damping_row_and_block(s, r, v0, acc, B);
-        if (sim->wind_normal) {
-            wind_row(sim, i, v0, acc);
-            wind_block(sim, i, B);
-        }
-        invert_block(sim->mass[i], sim->half_dt, B, w->block + 6 * i);
         double ri[3];
         for (int d = 0; d < 3; d++)
-            ri[d] = rhs[3 * i + d] - (sim->mass[i] * v0[3 * i + d] - sim->half_dt * acc[d]);
+            ri[d] = rhs[3 * i + d] - sim->mass[i] * v0[3 * i + d];
         project_row(sim, i, ri);
         double *wi = warm ? warm + 3 * i : NULL;
         if (wi)
@@ -221,16 +216,22 @@ int cs_cg_solve(cs_sim *sim, double *v0, const double *rhs, double *v, double *w
         }
     }
     cs_halo_forward(par, &par->ghosts, w->y, 3);
-    /* r = P (rhs - A y), p = P B^-1 r (y is read across particles here,
-     * so the preconditioned residual goes straight into p) */
+    /* r = P (rhs - A y), p = P B^-1 r, with B the diagonal blocks of A
+     * (y is read across particles here, so the preconditioned residual
+     * goes straight into p) */
     FOR_BLOCKS(sim, b, r0, r1) {
         double sum = 0, worst = 0;
         for (int r = r0; r < r1; r++) {
             int i = own[r];
-            double q[3], *ri = w->r + 3 * i, *pi = w->p + 3 * i;
-            system_row(sim, r, i, w->y, q);
+            double acc[3] = {0, 0, 0}, B[6], *ri = w->r + 3 * i, *pi = w->p + 3 * i;
+            damping_row_and_block(s, r, w->y, acc, B);
+            if (sim->wind_normal) {
+                wind_row(sim, i, w->y, acc);
+                wind_block(sim, i, B);
+            }
+            invert_block(sim->mass[i], sim->half_dt, B, w->block + 6 * i);
             for (int d = 0; d < 3; d++)
-                ri[d] = rhs[3 * i + d] - q[d];
+                ri[d] = rhs[3 * i + d] - (sim->mass[i] * w->y[3 * i + d] - sim->half_dt * acc[d]);
             project_row(sim, i, ri);
             precondition_row(sim, i, ri, pi, &sum, &worst);
         }

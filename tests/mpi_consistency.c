@@ -315,9 +315,11 @@ int main(int argc, char **argv)
     const char *stack[] = {"time.frames=8", "self_collision.zone_iterations=1"};
     test_collision_free_with_self_collision("stack.yaml", 8, 2, stack, CENTRE_BOUND, true);
     /* the strip knots onto itself; repulsions too thin to stop it, so step
-     * C's collisions and impact zones (early) do the work, across ranks */
+     * C's collisions and impact zones (early: after one pass, as for the
+     * stack; whether a second pass settles the knot's collisions turns on
+     * round-off and the solver's start) do the work, across ranks */
     const char *twist[] = {"cloths.0.grid.resolution=[40,10]", "time.frames=26",
-                           "self_collision.thickness=0.00001", "self_collision.zone_iterations=2"};
+                           "self_collision.thickness=0.00001", "self_collision.zone_iterations=1"};
     test_collision_free_with_self_collision("twist.yaml", 26, 4, twist, -1, false);
 
     int total = 0;
