@@ -89,12 +89,17 @@ static double phi_cylinder(double r, double hh, const double p[3], double g[3])
     return dy;
 }
 
-double cs_body_def_phi(const cs_body_def *b, double t, const double x[3], double grad[3])
+void cs_body_def_pose(const cs_body_def *b, double t, cs_body_pose *pose)
 {
-    double R[9], c[3], rel[3], p[3], g[3];
-    cs_motion_pose(&b->motion, t, R, c, NULL, NULL);
-    cs_sub(x, c, rel);
-    cs_mat_apply_transpose(R, rel, p);
+    cs_motion_pose(&b->motion, t, pose->R, pose->c, pose->velocity, pose->omega);
+}
+
+double cs_body_posed_phi(const cs_body_def *b, const cs_body_pose *pose, const double x[3],
+                         double grad[3])
+{
+    double rel[3], p[3], g[3];
+    cs_sub(x, pose->c, rel);
+    cs_mat_apply_transpose(pose->R, rel, p);
     double phi;
     if (b->phi_fn) {
         phi = b->phi_fn(b->phi_data, p, g);
@@ -107,18 +112,31 @@ double cs_body_def_phi(const cs_body_def *b, double t, const double x[3], double
         default: phi = phi_plane(p, g); break;
         }
     }
-    cs_mat_apply(R, g, grad);
+    cs_mat_apply(pose->R, g, grad);
     return phi;
+}
+
+double cs_body_def_phi(const cs_body_def *b, double t, const double x[3], double grad[3])
+{
+    cs_body_pose pose;
+    cs_body_def_pose(b, t, &pose);
+    return cs_body_posed_phi(b, &pose, x, grad);
+}
+
+void cs_body_posed_velocity(const cs_body_pose *pose, const double x[3], double v[3])
+{
+    double r[3], wr[3];
+    cs_sub(x, pose->c, r);
+    cs_cross(pose->omega, r, wr);
+    for (int i = 0; i < 3; i++)
+        v[i] = pose->velocity[i] + wr[i];
 }
 
 void cs_body_def_velocity(const cs_body_def *b, double t, const double x[3], double v[3])
 {
-    double c[3], vel[3], w[3], r[3], wr[3];
-    cs_motion_pose(&b->motion, t, NULL, c, vel, w);
-    cs_sub(x, c, r);
-    cs_cross(w, r, wr);
-    for (int i = 0; i < 3; i++)
-        v[i] = vel[i] + wr[i];
+    cs_body_pose pose;
+    cs_body_def_pose(b, t, &pose);
+    cs_body_posed_velocity(&pose, x, v);
 }
 
 /* Piecewise linear between the keys, constant outside them (the keys are

@@ -55,22 +55,31 @@ static double step_friction(const cs_sim *sim, const cs_body_def *body, double d
 
 /* The body as collisions see it: its surface moved out by the collision
  * offset (same gradient). */
-static double contact_phi(const cs_body_def *body, double t, const double x[3], double g[3])
+static double contact_phi(const cs_body_def *body, const cs_body_pose *pose, const double x[3],
+                          double g[3])
 {
-    return cs_body_def_phi(body, t, x, g) - body->offset;
+    return cs_body_posed_phi(body, pose, x, g) - body->offset;
+}
+
+/* Every body's pose at t1 = the step's end, once for the step's queries */
+static void pose_bodies(cs_sim *sim, double t1)
+{
+    for (int b = 0; b < sim->nbodies; b++)
+        cs_body_def_pose(sim->bodies + b, t1, sim->body_pose + b);
 }
 
 /* B.4 for particle i and body b; true when i is in contact with b (its
  * position then changed). Bodies are queried at time n+1, as the paper
  * prescribes. */
-static bool collide_one(cs_sim *sim, int i, int b, double t1, double dt, bool improved)
+static bool collide_one(cs_sim *sim, int i, int b, double dt, bool improved)
 {
     double *x = sim->x + 3 * i;
     const double *xn = sim->x_prev + 3 * i;
     double *vh = sim->v_half + 3 * i;
     const cs_body_def *body = sim->bodies + b;
+    const cs_body_pose *pose = sim->body_pose + b;
     double N[3], vb[3], vstar[3];
-    double phi1 = contact_phi(body, t1, x, N);
+    double phi1 = contact_phi(body, pose, x, N);
     if (!(phi1 < 0))
         return false;
     const double mu = step_friction(sim, body, dt);
@@ -78,8 +87,8 @@ static bool collide_one(cs_sim *sim, int i, int b, double t1, double dt, bool im
         /* crossing point along the step; phi at time n of the point
          * x^n is phi_{n+1}(x^n) + dt v_BN (the body moved since) */
         double Nn[3];
-        double phi0 = contact_phi(body, t1, xn, Nn);
-        cs_body_def_velocity(body, t1, xn, vb);
+        double phi0 = contact_phi(body, pose, xn, Nn);
+        cs_body_posed_velocity(pose, xn, vb);
         phi0 += dt * cs_dot(vb, N);
         double theta = phi0 > 0 ? phi0 / (phi0 - phi1) : 0.0;
         if (theta > 1)
@@ -88,21 +97,21 @@ static bool collide_one(cs_sim *sim, int i, int b, double t1, double dt, bool im
         for (int d = 0; d < 3; d++)
             xc[d] = xn[d] + theta * (x[d] - xn[d]);
         double Nc[3];
-        cs_body_def_phi(body, t1, xc, Nc);
+        cs_body_posed_phi(body, pose, xc, Nc);
         memcpy(N, Nc, sizeof N);
-        cs_body_def_velocity(body, t1, xc, vb);
+        cs_body_posed_velocity(pose, xc, vb);
         cs_gamma(vh, N, vb, mu, vstar);
         memcpy(vh, vstar, sizeof vstar);
         for (int d = 0; d < 3; d++)
             x[d] = xc[d] + (1.0 - theta) * dt * vstar[d];
         /* On curved or turning bodies the linearisation can leave the
          * point a little inside: finish along the normal there. */
-        double g[3], phi = contact_phi(body, t1, x, g);
+        double g[3], phi = contact_phi(body, pose, x, g);
         if (phi < 0)
             cs_axpy(-phi, g, x);
     } else {
         cs_axpy(-phi1, N, x); /* Fig. 6 left: straight out along N */
-        cs_body_def_velocity(body, t1, x, vb);
+        cs_body_posed_velocity(pose, x, vb);
     }
     cs_gamma(sim->v + 3 * i, N, vb, mu, sim->v_star + 3 * i);
     memcpy(sim->contact_normal + 3 * i, N, sizeof N);
@@ -155,7 +164,7 @@ typedef struct collide_ctx {
     cs_body_grid *g;
     late_queue q;
     int *seen;            /* seen[i] == b: i has met body b */
-    double t1, dt;
+    double dt;
     bool improved;
 } collide_ctx;
 
@@ -166,7 +175,7 @@ static void visit(collide_ctx *c, int i, int b)
             return;
         c->seen[i] = b;
     }
-    if (!collide_one(c->sim, i, b, c->t1, c->dt, c->improved) || !c->g->ok)
+    if (!collide_one(c->sim, i, b, c->dt, c->improved) || !c->g->ok)
         return;
     const double *x = c->sim->x + 3 * i;
     int first, last;
@@ -200,7 +209,8 @@ void cs_body_collide(cs_sim *sim, double dt)
     /* each rank: its own free particles (sim->active) */
     cs_body_grid g;
     cs_body_grid_build(&g, sim->bodies, nb, sim->t + dt, sim->x, sim->active, n);
-    collide_ctx c = {.sim = sim, .g = &g, .t1 = sim->t + dt, .dt = dt,
+    pose_bodies(sim, sim->t + dt);
+    collide_ctx c = {.sim = sim, .g = &g, .dt = dt,
                      .improved = sim->def.friction_method == CS_FRICTION_IMPROVED};
     c.q.all_from = nb;
     if (g.ok) {
@@ -250,13 +260,12 @@ void cs_body_collide(cs_sim *sim, double dt)
  * apply Gamma with the contact normal and the body's velocity at n+1. */
 void cs_body_friction(cs_sim *sim, double dt)
 {
-    double t1 = sim->t + dt;
-    CS_FOR_OWNED(sim->par, i) {
+    CS_FOR_OWNED(sim->par, i) { /* the poses of B.4, the same step's end */
         int b = sim->contact_body[i];
         if (b < 0)
             continue;
         double vb[3], out[3];
-        cs_body_def_velocity(sim->bodies + b, t1, sim->x + 3 * i, vb);
+        cs_body_posed_velocity(sim->body_pose + b, sim->x + 3 * i, vb);
         cs_gamma(sim->v_next + 3 * i, sim->contact_normal + 3 * i, vb,
                  step_friction(sim, sim->bodies + b, dt), out);
         memcpy(sim->v_next + 3 * i, out, sizeof out);

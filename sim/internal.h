@@ -87,6 +87,8 @@ struct cs_sim {
     /* body stages only */
     double *contact_normal;       /* 3 per particle */
     int *contact_body;            /* -1 when not in contact */
+    cs_body_pose *body_pose;      /* per body, at the end of the step B.4 and
+                                     B.7 are in (computed once per step) */
     /* self-collision stages only */
     cs_selfcol *selfcol;
     double *v_rewind;             /* rewind scheme: velocities at the outer step's start */

@@ -335,9 +335,11 @@ int cs_sim_create_checked(const cs_sim_def *def, cs_sim **out, char *err, size_t
     if (cs_plan_has(&sim->plan, CS_STAGE_BODY_COLLISION) && !def->plan_only) {
         sim->contact_normal = alloc3(n);
         sim->contact_body = calloc((size_t)n + 1, sizeof *sim->contact_body);
-        if (!sim->contact_normal || !sim->contact_body)
+        sim->body_pose = calloc((size_t)def->nbodies + 1, sizeof *sim->body_pose);
+        if (!sim->contact_normal || !sim->contact_body || !sim->body_pose)
             goto nomem;
-        sim->stage_bytes[CS_STAGE_BODY_COLLISION] = (3 * sizeof(double) + sizeof(int)) * (size_t)n;
+        sim->stage_bytes[CS_STAGE_BODY_COLLISION] = (3 * sizeof(double) + sizeof(int)) * (size_t)n +
+                                                     sizeof(cs_body_pose) * (size_t)def->nbodies;
     }
     if (cs_plan_has(&sim->plan, CS_STAGE_WIND) && !def->plan_only) {
         sim->wind_normal = alloc3(n);
@@ -458,6 +460,7 @@ void cs_sim_destroy(cs_sim *sim)
     free(sim->script_lag);
     free(sim->script_lag_start);
     free(sim->contact_body);
+    free(sim->body_pose);
     free(sim);
 }
 

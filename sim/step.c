@@ -146,13 +146,13 @@ static void copy_ranges(const int *ranges, int nranges, double *dst, const doubl
  * undamped limit the explicit pull grows without bound. Such a particle
  * leaves the body: it takes the projected solve's velocity, as the
  * previous method would give it, and B.4 stops holding it next step. */
-static void release_separating(cs_sim *sim, int i, double t1, const double *v_p)
+static void release_separating(cs_sim *sim, int i, const double *v_p)
 {
     int b = sim->contact_body[i];
     if (b < 0)
         return;
     double vb[3], rel[3];
-    cs_body_def_velocity(sim->bodies + b, t1, sim->x + 3 * i, vb);
+    cs_body_posed_velocity(sim->body_pose + b, sim->x + 3 * i, vb); /* B.4's, at t1 */
     cs_sub(sim->v_next + 3 * i, vb, rel);
     if (cs_dot(rel, sim->contact_normal + 3 * i) <= 0)
         return;
@@ -263,7 +263,7 @@ static const double *stage_velocity_full(cs_sim *sim, const step_state *st)
                 double v_np = sim->v_star[k] + sim->half_dt / sim->mass[i] * sim->v_next[k];
                 sim->v_next[k] = 2.0 * v_np - sim->v_star[k];
             }
-            release_separating(sim, i, st->t1, v_p);
+            release_separating(sim, i, v_p);
         }
     } else {
         CS_PARALLEL_FOR_OWNED(par, i)
