@@ -684,6 +684,8 @@ void cs_selfcol_find_pairs(cs_sim *sim, double span)
     for (int i = 0; i < sc->n; i++)
         cs_axpy(1.0 / sc->n, sim->v + 3 * i, mean);
     double *margin = sim->force; /* scratch, free between steps */
+    /* the boxes: one writer each, so threads change no bit */
+#pragma omp parallel for schedule(static)
     for (int i = 0; i < sc->n; i++) {
         double rel[3];
         cs_sub(sim->v + 3 * i, mean, rel);
@@ -692,6 +694,7 @@ void cs_selfcol_find_pairs(cs_sim *sim, double span)
         cs_box_add_point(sc->pbox + i, x + 3 * i);
         cs_box_thicken(sc->pbox + i, margin[i]);
     }
+#pragma omp parallel for schedule(static)
     for (int k = 0; k < sc->ne; k++) {
         cs_box *b = sc->ebox + k;
         cs_box_empty(b);
@@ -702,6 +705,7 @@ void cs_selfcol_find_pairs(cs_sim *sim, double span)
             cs_box_add_point(b, pb.hi);
         }
     }
+#pragma omp parallel for schedule(static)
     for (int k = 0; k < sc->nt; k++) {
         cs_box *b = sc->tbox + k;
         cs_box_empty(b);

@@ -131,12 +131,13 @@ static void explicit_forces(cs_sim *sim, const double *x, const double *v_start)
     }
 }
 
-/* Copies 3 doubles per particle over the given ranges. */
+/* Copies 3 doubles per particle over the given ranges, shared among the
+ * threads (a serial copy left the other thread waiting: perf put 1.6% of
+ * the 100 x 100 run's samples in it, all on the main thread). */
 static void copy_ranges(const int *ranges, int nranges, double *dst, const double *src)
 {
-    for (int r = 0; r < nranges; r++)
-        memcpy(dst + 3 * ranges[2 * r], src + 3 * ranges[2 * r],
-               sizeof(double) * 3 * (size_t)(ranges[2 * r + 1] - ranges[2 * r]));
+    CS_PARALLEL_FOR_RANGES(ranges, nranges, i)
+        memcpy(dst + 3 * i, src + 3 * i, 3 * sizeof(double));
 }
 
 /* The improved method applies B.5's forces without the contact
