@@ -10,13 +10,14 @@
  *
  * v0 the fastest initial velocity; |g| t what gravity can give since the
  * start; body(t) and script(t) the fastest surface point of a moving body
- * or a scripted vertex set so far (cloth keeps what a driver gave it after
- * the driver stops; a held script's at its own, lagging clock) (|v| + |w| r over its extent); c the fastest
- * elastic wave, sqrt(E L0 / m) over the edge springs: a stretch of strain e
- * released sends its ends back at e c, and cloth that was stretched by a
- * quarter is far beyond Table 1's (stiff cloth, c of hundreds of m/s). The factor 10 leaves room for
- * whips and snaps (a cloth corner can outrun what drives it); a real
- * blow-up grows geometrically and passes any such bound within a few steps.
+ * or a scripted vertex set so far, |v| + |w| r over its extent (cloth keeps
+ * what a driver gave it after the driver stops; a held script's at its own,
+ * lagging clock); c the fastest elastic wave, sqrt(E L0 / m) over the edge
+ * springs: a stretch of strain e released sends its ends back at e c, and
+ * cloth that was stretched by a quarter is far beyond Table 1's (stiff
+ * cloth, c of hundreds of m/s). The factor 10 leaves room for whips and
+ * snaps (a cloth corner can outrun what drives it); a real blow-up grows
+ * geometrically and passes any such bound within a few steps.
  * An unbounded body that rotates (a spinning plane) has no finite surface
  * speed: the limit is then infinite and only NaN is caught.
  *
