@@ -39,22 +39,25 @@ static inline void damping_row_and_block(const cs_springs *s, int r, const doubl
                                          double acc[3], double B[6])
 {
     const double *vi = v + 3 * s->row_particle[r];
-    double b0 = 0, b1 = 0, b2 = 0, b3 = 0, b4 = 0, b5 = 0;
-    for (int e = s->row_start[r]; e < s->row_start[r + 1]; e++) {
-        const double *w = s->row_direction + 3 * e, *vo = v + 3 * s->row_other[e];
-        double w0 = w[0], w1 = w[1], w2 = w[2];
-        double mag = (vo[0] - vi[0]) * w0 + (vo[1] - vi[1]) * w1 + (vo[2] - vi[2]) * w2;
-        acc[0] += mag * w0;
-        acc[1] += mag * w1;
-        acc[2] += mag * w2;
-        b0 += w0 * w0;
-        b1 += w1 * w1;
-        b2 += w2 * w2;
-        b3 += w0 * w1;
-        b4 += w0 * w2;
-        b5 += w1 * w2;
+    cs_pair2 ax = {0, 0}, ay = {0, 0}, az = {0, 0};
+    cs_pair2 b0 = {0, 0}, b1 = {0, 0}, b2 = {0, 0}, b3 = {0, 0}, b4 = {0, 0}, b5 = {0, 0};
+    for (int e = s->row_start[r]; e < s->row_start[r + 1]; e += 2) {
+        cs_pair2 w[3], mag = cs_springs_pair_damping(s, e, v, vi, w);
+        ax += mag * w[0];
+        ay += mag * w[1];
+        az += mag * w[2];
+        b0 += w[0] * w[0];
+        b1 += w[1] * w[1];
+        b2 += w[2] * w[2];
+        b3 += w[0] * w[1];
+        b4 += w[0] * w[2];
+        b5 += w[1] * w[2];
     }
-    B[0] = b0, B[1] = b1, B[2] = b2, B[3] = b3, B[4] = b4, B[5] = b5;
+    acc[0] += ax[0] + ax[1];
+    acc[1] += ay[0] + ay[1];
+    acc[2] += az[0] + az[1];
+    B[0] = b0[0] + b0[1], B[1] = b1[0] + b1[1], B[2] = b2[0] + b2[1];
+    B[3] = b3[0] + b3[1], B[4] = b4[0] + b4[1], B[5] = b5[0] + b5[1];
 }
 
 /* B += the wind drag's block c n n^T */

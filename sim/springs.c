@@ -3,6 +3,9 @@
 #include <stdbool.h>
 #include <stdlib.h>
 #include <string.h>
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
 
 #include "sim/springs.h"
 #include "sim/vec3.h"
@@ -124,9 +127,9 @@ int cs_springs_add_mesh(cs_springs *s, int offset, int nv, int nt, const int *tr
 
 static void free_rows(cs_springs *s)
 {
-    void *rows[] = {s->row_start,     s->row_other,     s->row_mirror,
-                    s->row_sqrt_damping, s->row_direction, s->row_magnitude,
-                    s->row_stiffness, s->row_inv_rest_length};
+    void *rows[] = {s->row_start,         s->row_other,     s->row_sqrt_damping,
+                    s->row_direction,     s->row_magnitude, s->row_stiffness,
+                    s->row_inv_rest_length};
     for (size_t k = 0; k < sizeof rows / sizeof *rows; k++)
         free(rows[k]);
 }
@@ -135,19 +138,13 @@ int cs_springs_index(cs_springs *s, int nrows, const int *particles, int npartic
 {
     free_rows(s);
     s->nrows = nrows;
-    s->row_sqrt_damping = malloc(sizeof(double) * (2 * (size_t)s->n + 1));
-    s->row_direction = malloc(sizeof(double) * 3 * (2 * (size_t)s->n + 1));
-    s->row_magnitude = malloc(sizeof(double) * (2 * (size_t)s->n + 1));
-    s->row_stiffness = malloc(sizeof(double) * (2 * (size_t)s->n + 1));
-    s->row_inv_rest_length = malloc(sizeof(double) * (2 * (size_t)s->n + 1));
     s->row_particle = particles;
     s->row_start = calloc((size_t)nrows + 1, sizeof *s->row_start);
-    s->row_other = malloc(sizeof *s->row_other * (2 * (size_t)s->n + 1));
-    s->row_mirror = malloc(sizeof *s->row_mirror * (2 * (size_t)s->n + 1));
     int *row_of = malloc(sizeof *row_of * ((size_t)nparticles + 1));
-    if (!s->row_start || !s->row_other || !s->row_mirror || !row_of || !s->row_sqrt_damping ||
-        !s->row_direction || !s->row_magnitude || !s->row_stiffness || !s->row_inv_rest_length) {
+    int *fill = malloc(sizeof *fill * ((size_t)nrows + 1));
+    if (!s->row_start || !row_of || !fill) {
         free(row_of);
+        free(fill);
         return -1;
     }
     for (int i = 0; i < nparticles; i++)
@@ -159,30 +156,39 @@ int cs_springs_index(cs_springs *s, int nrows, const int *particles, int npartic
         if (r >= 0)
             s->row_start[r + 1]++;
     }
-    for (int r = 0; r < nrows; r++)
-        s->row_start[r + 1] += s->row_start[r];
-    int *fill = malloc(sizeof *fill * ((size_t)nrows + 1));
-    if (!fill) {
+    for (int r = 0; r < nrows; r++) /* each row even (cs_pair2) */
+        s->row_start[r + 1] += s->row_start[r] + (s->row_start[r + 1] & 1);
+    size_t n = (size_t)s->row_start[nrows] + 1;
+    s->nentries = s->row_start[nrows];
+    s->row_sqrt_damping = malloc(sizeof(double) * n);
+    s->row_direction = malloc(sizeof(double) * 3 * n);
+    s->row_magnitude = malloc(sizeof(double) * n);
+    s->row_stiffness = malloc(sizeof(double) * n);
+    s->row_inv_rest_length = malloc(sizeof(double) * n);
+    s->row_other = malloc(sizeof *s->row_other * n);
+    if (!s->row_other || !s->row_sqrt_damping || !s->row_direction || !s->row_magnitude ||
+        !s->row_stiffness || !s->row_inv_rest_length) {
         free(row_of);
+        free(fill);
         return -1;
     }
     memcpy(fill, s->row_start, sizeof *fill * (size_t)nrows);
     for (int k = 0; k < s->n; k++) { /* ascending k: each row in spring order */
-        int at[2] = {-1, -1};
         for (int e = 0; e < 2; e++) {
             int r = row_of[s->ends[2 * k + e]];
             if (r < 0)
                 continue;
-            at[e] = fill[r];
             s->row_sqrt_damping[fill[r]] = sqrt(s->damping[k]);
             s->row_stiffness[fill[r]] = s->stiffness[k];
             s->row_inv_rest_length[fill[r]] = s->inv_rest_length[k];
             s->row_other[fill[r]++] = s->ends[2 * k + 1 - e];
         }
-        for (int e = 0; e < 2; e++)
-            if (at[e] >= 0)
-                s->row_mirror[at[e]] = at[1 - e];
     }
+    for (int r = 0; r < nrows; r++)
+        for (int e = fill[r]; e < s->row_start[r + 1]; e++) { /* the pad */
+            s->row_sqrt_damping[e] = s->row_stiffness[e] = s->row_inv_rest_length[e] = 0;
+            s->row_other[e] = particles[r];
+        }
     free(fill);
     free(row_of);
     return 0;
@@ -199,70 +205,80 @@ void cs_springs_free(cs_springs *s)
     memset(s, 0, sizeof *s);
 }
 
+typedef long long pair2_mask __attribute__((vector_size(16))); /* all ones or zeros */
+
+/* a where mask, b elsewhere */
+static inline cs_pair2 pair2_select(pair2_mask mask, cs_pair2 a, cs_pair2 b)
+{
+    return (cs_pair2)(((pair2_mask)a & mask) | ((pair2_mask)b & ~mask));
+}
+
+/* a where mask, 0 elsewhere */
+static inline cs_pair2 pair2_keep(cs_pair2 a, pair2_mask mask)
+{
+    return (cs_pair2)((pair2_mask)a & mask);
+}
+
+/* sqrt per lane, correctly rounded as sqrt() */
+static inline cs_pair2 pair2_sqrt(cs_pair2 a)
+{
+#if defined(__SSE2__)
+    return (cs_pair2)_mm_sqrt_pd((__m128d)a);
+#else
+    return (cs_pair2){sqrt(a[0]), sqrt(a[1])};
+#endif
+}
+
 /* Seen from either end, a spring's terms are the same expression in
  * (self, other): u = x_other - x_self pulls self towards other when
- * stretched, and (v_other - v_self) . u_hat damps their approach. The
- * negations this swaps in are exact, so gathering reproduces the
- * scatter's numbers bit for bit. */
-void cs_springs_prepare(cs_springs *s, const double *x)
+ * stretched, and (v_other - v_self) . u_hat damps their approach. Every
+ * row computes its own entries, so a spring between two rows is computed
+ * twice; the two give the same direction negated and the same magnitude
+ * (x_i - x_j = -(x_j - x_i) in floating point), and a row needs nothing
+ * another thread writes: the elastic forces come in the same pass. (One
+ * computation per spring, written to both ends, cost a second pass and
+ * scattered writes; in pairs, two sqrt and divisions cost one.) */
+static void prepare_rows(cs_springs *s, const double *x, double *f)
 {
-    /* a spring with both ends in rows is computed once, from its first
-     * entry, which writes the mirror entry too: the far end's direction is
-     * -u exactly (x_i - x_j = -(x_j - x_i) in floating point, and l, the
-     * constants and so the magnitude are the same), so the sums are the
-     * same bits as computing both ends; each entry has one writer */
 #pragma omp parallel for schedule(static)
     for (int r = 0; r < s->nrows; r++) {
-        const double *xi = x + 3 * s->row_particle[r];
-        for (int e = s->row_start[r]; e < s->row_start[r + 1]; e++) {
-            int m = s->row_mirror[e];
-            if (m >= 0 && m < e)
-                continue;
-            /* u in registers: writing it and reading it back as a
-             * vector stalled on store forwarding (perf: 44% of this loop) */
-            const double *xo = x + 3 * s->row_other[e];
-            double u[3] = {xo[0] - xi[0], xo[1] - xi[1], xo[2] - xi[2]};
-            double l = sqrt(u[0] * u[0] + u[1] * u[1] + u[2] * u[2]);
-            /* one division: E (l / L0 - 1) / l = E / L0 - E / l, and u / l
-             * (coincident ends: no direction to push along) */
-            double inv = l > 0 ? 1.0 / l : 0;
-            double mag = l > 0 ? s->row_stiffness[e] * (s->row_inv_rest_length[e] - inv) : 0;
-            double scale = inv * s->row_sqrt_damping[e];
-            double w[3] = {u[0] * scale, u[1] * scale, u[2] * scale};
-            double *we = s->row_direction + 3 * e;
-            we[0] = w[0];
-            we[1] = w[1];
-            we[2] = w[2];
-            s->row_magnitude[e] = mag;
-            if (m >= 0) {
-                double *wm = s->row_direction + 3 * m;
-                wm[0] = -w[0];
-                wm[1] = -w[1];
-                wm[2] = -w[2];
-                s->row_magnitude[m] = mag;
-            }
+        int i = s->row_particle[r];
+        const double *xi = x + 3 * i;
+        cs_pair2 fx = {0, 0}, fy = {0, 0}, fz = {0, 0};
+        for (int e = s->row_start[r]; e < s->row_start[r + 1]; e += 2) {
+            cs_pair2 ux = cs_pair2_gather(x, s->row_other, e, 0, xi[0]);
+            cs_pair2 uy = cs_pair2_gather(x, s->row_other, e, 1, xi[1]);
+            cs_pair2 uz = cs_pair2_gather(x, s->row_other, e, 2, xi[2]);
+            cs_pair2 l = pair2_sqrt(ux * ux + uy * uy + uz * uz);
+            /* one division: E (l / L0 - 1) / l = E / L0 - E / l, and u / l;
+             * coincident ends (and the pads) have no direction to push
+             * along: inv = 0 there, and so magnitude and direction. Masks,
+             * not branches: a pad's branch was mispredicted in every odd
+             * row. */
+            pair2_mask pos = l > 0;
+            cs_pair2 inv = pair2_keep(1.0 / pair2_select(pos, l, (cs_pair2){1, 1}), pos);
+            cs_pair2 mag = pair2_keep(cs_pair2_load(s->row_stiffness + e) *
+                                          (cs_pair2_load(s->row_inv_rest_length + e) - inv),
+                                      pos);
+            cs_pair2 scale = inv * cs_pair2_load(s->row_sqrt_damping + e);
+            cs_pair2 w[3] = {ux * scale, uy * scale, uz * scale};
+            memcpy(s->row_direction + 3 * e, w, sizeof w);
+            memcpy(s->row_magnitude + e, &mag, sizeof mag);
+            fx += mag * ux;
+            fy += mag * uy;
+            fz += mag * uz;
+        }
+        if (f) {
+            f[3 * i] += fx[0] + fx[1];
+            f[3 * i + 1] += fy[0] + fy[1];
+            f[3 * i + 2] += fz[0] + fz[1];
         }
     }
 }
 
-void cs_springs_add_elastic(cs_springs *s, const double *x, double *f)
-{
-    cs_springs_prepare(s, x);
-#pragma omp parallel for schedule(static)
-    for (int r = 0; r < s->nrows; r++) {
-        int i = s->row_particle[r];
-        double acc[3] = {f[3 * i], f[3 * i + 1], f[3 * i + 2]};
-        for (int e = s->row_start[r]; e < s->row_start[r + 1]; e++) {
-            double mag = s->row_magnitude[e];
-            if (mag == 0)
-                continue; /* at rest length, or coincident ends */
-            double u[3];
-            cs_sub(x + 3 * s->row_other[e], x + 3 * i, u);
-            cs_axpy(mag, u, acc);
-        }
-        memcpy(f + 3 * i, acc, sizeof acc);
-    }
-}
+void cs_springs_prepare(cs_springs *s, const double *x) { prepare_rows(s, x, NULL); }
+
+void cs_springs_add_elastic(cs_springs *s, const double *x, double *f) { prepare_rows(s, x, f); }
 
 void cs_springs_add_damping(const cs_springs *s, const double *v, double *out)
 {
