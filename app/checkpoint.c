@@ -17,7 +17,7 @@
 #endif
 
 #define STATE_FORMAT "clothsim state"
-enum { STATE_FORMAT_VERSION = 1 };
+enum { STATE_FORMAT_VERSION = 2 }; /* 2: the warm starts' histories */
 
 /* ----------------------------------------------------------------- hashes */
 

@@ -52,7 +52,9 @@ typedef struct cs_cg_work {
     double *z, *r, *y, *p, *q, *b;
     double *explicit_z;          /* the explicit update CG starts from */
     double *block;               /* 6 per particle: the preconditioner's 3 x 3 inverse */
-    double *warm_half, *warm_full; /* last damping responses of B.1 and B.5 */
+    /* the damping responses of B.1's and B.5's last solves, and of the
+     * solves before those (cs_cg_solve starts from a blend of the two) */
+    double *warm_half, *warm_full, *warm_half_before, *warm_full_before;
     double *partial;  /* 2 per block: a partial sum and a partial maximum */
     double *inv_mass; /* 1 / m per particle: multiplies where the solve divided */
 } cs_cg_work;
@@ -126,7 +128,8 @@ int cs_sort_unique_pairs(int *pairs, int n);
  * warm (3 per particle, or NULL) holds the damping response of the last
  * solve of the same kind, added to the start, and receives this one's.
  * Returns the iteration count, the same on every rank. */
-int cs_cg_solve(cs_sim *sim, double *v0, const double *rhs, double *v, double *warm);
+int cs_cg_solve(cs_sim *sim, double *v0, const double *rhs, double *v, double *warm,
+                double *warm_before);
 /* out = (M - (dt/2) D) v, D the damping (and wind drag) velocity Jacobian. */
 void cs_system_apply(const cs_sim *sim, const double *v, double *out);
 /* out += D v (damping plus implicit wind drag). */

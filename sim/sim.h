@@ -539,7 +539,7 @@ typedef struct cs_state_array {
     double *data;       /* into the simulation: read to store, write to restore */
 } cs_state_array;
 
-enum { CS_STATE_MAX_ARRAYS = 8 };
+enum { CS_STATE_MAX_ARRAYS = 10 };
 
 /* The arrays (at most CS_STATE_MAX_ARRAYS) in *arrays; returns how many.
  * The list and the sizes are the same on every rank and for every

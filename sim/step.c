@@ -200,7 +200,8 @@ static const double *stage_velocity_half(cs_sim *sim, const step_state *st)
             for (int d = 0; d < 3; d++)
                 sim->v0[3 * i + d] = (sim->script_x[3 * i + d] - sim->x[3 * i + d]) / st->dt;
     explicit_forces(sim, sim->x, sim->v); /* prepares the springs' directions at x^n too */
-    sim->cg_iterations += cs_cg_solve(sim, sim->v0, sim->rhs, sim->v_half, sim->cg.warm_half);
+    sim->cg_iterations += cs_cg_solve(sim, sim->v0, sim->rhs, sim->v_half, sim->cg.warm_half,
+                                      sim->cg.warm_half_before);
     return sim->v_half;
 }
 
@@ -253,7 +254,8 @@ static const double *stage_velocity_full(cs_sim *sim, const step_state *st)
     explicit_forces(sim, sim->v_half, sim->v_star); /* and at x^(n+1/2) */
     double *v_p = sim->v0; /* v0 is free again */
     copy_ranges(par->own, par->nown, sim->cg.b, sim->v_star);
-    sim->cg_iterations += cs_cg_solve(sim, sim->cg.b, sim->rhs, v_p, sim->cg.warm_full);
+    sim->cg_iterations += cs_cg_solve(sim, sim->cg.b, sim->rhs, v_p, sim->cg.warm_full,
+                                      sim->cg.warm_full_before);
     if (st->bodies && sim->def.friction_method == CS_FRICTION_IMPROVED) {
         copy_ranges(par->local, par->nlocal, sim->v_next, sim->force);
         cs_halo_forward(par, &par->ghosts, v_p, 3);
