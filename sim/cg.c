@@ -264,8 +264,8 @@ int cs_cg_solve(cs_sim *sim, double *v0, const double *rhs, double *v, double *w
      * folded into the next operator pass, which applies A to y instead
      * and takes P A p = P A y + beta q (A and P are fixed within the
      * solve); the third pass and its fork and join had 2% of a contact
-     * frame's samples
-     * (the first iteration applies A to p, which the setup pass made). */
+     * frame's samples (the first iteration applies A to p, which the
+     * setup pass made). */
     int it = 0;
     double beta = 0;
     while (it < sim->def.cg_max_iterations && residual > sim->def.cg_tolerance) {
