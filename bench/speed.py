@@ -135,14 +135,18 @@ def main():
                 "frames_checked": len(inter),
                 "ns_per_spring_step": 1e9 * inner / max(steps * springs, 1),
             }
-            # traffic model of one step, if every byte came from memory: a
-            # pass over the springs streams 2 rows of (spring index 4 B, far
-            # end 4 B, direction 24 B, damping 8 B) per spring; a step makes
-            # 2 elastic, 2 prepare, 2 diagonal, 4 CG start-up and 1 v_NP
-            # passes plus one per CG iteration; CG's vectors add about 10
-            # arrays of 24 B per particle per iteration plus 12 per step.
-            passes = 11 + cg / max(steps, 1)
-            bytes_step = springs * 80 * passes + s["particles"] * 24 * (12 + 10 * cg / max(steps, 1))
+            # traffic model of one step, if every byte came from memory
+            # (sim/springs.c, sim/cg.c as of 2026-12-02): every spring is an
+            # entry in both its ends' rows. The prepare pass (twice a step)
+            # reads an entry's far end (4 B) and 3 constants (24 B) and
+            # writes its direction (24 B) and magnitude (8 B): 120 B per
+            # spring. A damping pass reads far end and direction: 56 B per
+            # spring; a step makes 2 CG setup passes, 1 for v_NP and one
+            # per CG iteration. CG's vectors: about 14 arrays of 24 B per
+            # particle per iteration, and 30 per step for the rest.
+            it_step = cg / max(steps, 1)
+            bytes_step = springs * (2 * 120 + 56 * (3 + it_step)) + \
+                s["particles"] * 24 * (30 + 14 * it_step)
             row["model_GBps"] = bytes_step * steps / inner / 1e9 if inner > 0 else 0
             row["triad_GBps"] = bw or 0
             rows.append(row)
