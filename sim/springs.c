@@ -127,11 +127,15 @@ int cs_springs_add_mesh(cs_springs *s, int offset, int nv, int nt, const int *tr
 
 static void free_rows(cs_springs *s)
 {
-    void *rows[] = {s->row_start,         s->row_other,     s->row_sqrt_damping,
-                    s->row_direction,     s->row_magnitude, s->row_stiffness,
-                    s->row_inv_rest_length};
-    for (size_t k = 0; k < sizeof rows / sizeof *rows; k++)
-        free(rows[k]);
+    free(s->row_start);
+    free(s->row_other);
+    double **rows[] = {&s->row_sqrt_damping, &s->row_direction, &s->row_magnitude,
+                       &s->row_stiffness, &s->row_inv_rest_length};
+    for (size_t k = 0; k < sizeof rows / sizeof *rows; k++) {
+        free(*rows[k]);
+        *rows[k] = NULL; /* cs_springs_index may fail before replacing them */
+    }
+    s->row_start = s->row_other = NULL;
 }
 
 int cs_springs_index(cs_springs *s, int nrows, const int *particles, int nparticles)
