@@ -177,10 +177,6 @@ static double reduce(cs_sim *sim, const double *sum, const double *max, double *
                                              ? r0 + CS_BLOCK : (sim)->par->nowned;   \
              r0 < r1; r0 = r1)
 
-/* v0 is read and v written where owned (y, the start, is sent to the
- * ghosts). The stopping test is the residual in velocity units, max over
- * particles of |r_i| / m_i: a maximum is exact, so every rank and thread
- * count stops at the same iteration. */
 /* The warm start's weight on the damping response of the solve before the
  * last (the last's is 1 minus it). Table 1's damping is 15 times critical,
  * and the trapezoidal step turns a mode damped that hard into one whose
@@ -192,6 +188,10 @@ static double reduce(cs_sim *sim, const double *sum, const double *max, double *
  * 0.75. */
 static const double WARM_BEFORE_WEIGHT = 0.75;
 
+/* v0 is read and v written where owned (y, the start, is sent to the
+ * ghosts). The stopping test is the residual in velocity units, max over
+ * particles of |r_i| / m_i: a maximum is exact, so every rank and thread
+ * count stops at the same iteration. */
 int cs_cg_solve(cs_sim *sim, double *v0, const double *rhs, double *v, double *warm,
                 double *warm_before)
 {
