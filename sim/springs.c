@@ -163,7 +163,6 @@ int cs_springs_index(cs_springs *s, int nrows, const int *particles, int npartic
     for (int r = 0; r < nrows; r++) /* each row even (cs_pair2) */
         s->row_start[r + 1] += s->row_start[r] + (s->row_start[r + 1] & 1);
     size_t n = (size_t)s->row_start[nrows] + 1;
-    s->nentries = s->row_start[nrows];
     s->row_sqrt_damping = malloc(sizeof(double) * n);
     s->row_direction = malloc(sizeof(double) * 3 * n);
     s->row_magnitude = malloc(sizeof(double) * n);

@@ -31,7 +31,7 @@ typedef struct cs_springs {
      * order at any thread count. A row has an even number of entries (see
      * cs_pair2), padded with an entry of zero constants whose far end is
      * the particle itself: it adds exactly zero. */
-    int nrows, nentries;
+    int nrows;
     const int *row_particle;
     int *row_start, *row_other;
     /* per row entry, so the gathers stream: the spring's constants, and
