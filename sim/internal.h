@@ -125,8 +125,9 @@ int cs_sort_unique_pairs(int *pairs, int n);
 /* cg.c: solves P (M - (dt/2) D) P z = P (rhs - (M - (dt/2) D) v0) for v = v0 + z,
  * where P projects out fixed velocities and contact normals, over all
  * ranks (v0's ghosts are refreshed first; v is written where owned).
- * warm (3 per particle, or NULL) holds the damping response of the last
- * solve of the same kind, added to the start, and receives this one's.
+ * warm and warm_before (3 per particle each, or both NULL) hold the
+ * damping responses of the last two solves of the same kind, whose blend
+ * is added to the start; they shift by one, warm receiving this one's.
  * Returns the iteration count, the same on every rank. */
 int cs_cg_solve(cs_sim *sim, double *v0, const double *rhs, double *v, double *warm,
                 double *warm_before);
