@@ -582,7 +582,7 @@ static int render_turntable(job *j, int f)
     }
     double t = f / j->fps, centre[3];
     cs_scene_render_centre(j->sr, t, &j->geom.cloths, centre);
-    const cs_render_camera *cam = cs_scene_render_camera(j->sr);
+    cs_render_camera cam = cs_scene_render_camera(j->sr, t);
     int thumb = j->image->width < 200 ? j->image->width : 200;
     cs_image **thumbs = calloc((size_t)n, sizeof *thumbs);
     char (*labels)[48] = calloc((size_t)n, sizeof *labels);
@@ -593,7 +593,7 @@ static int render_turntable(job *j, int f)
     }
     for (int k = 0; k < n && status == CS_EXIT_OK; k++) {
         double angle = 2 * M_PI * k / n;
-        cs_render_camera view = cs_render_camera_orbit(cam, centre, cam->up, angle);
+        cs_render_camera view = cs_render_camera_orbit(&cam, centre, cam.up, angle);
         cs_render_stats st;
         status = cs_scene_render_draw(j->sr, t, &j->geom.cloths, &view, j->image, &st, err,
                                       sizeof err);

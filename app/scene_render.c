@@ -270,9 +270,27 @@ void cs_scene_render_destroy(cs_scene_render *sr)
     free(sr);
 }
 
-const cs_render_camera *cs_scene_render_camera(const cs_scene_render *sr)
+cs_render_camera cs_scene_render_camera(const cs_scene_render *sr, double t)
 {
-    return &sr->camera;
+    cs_render_camera cam = sr->camera;
+    const cs_camera_def *def = &sr->scene->camera;
+    if (!def->given || def->motion.kind == CS_MOTION_STATIC)
+        return cam;
+    /* the motion's frame starts at the target with no rotation */
+    double R[9], c[3], rel[3];
+    cs_motion_pose(&def->motion, t, R, c, NULL, NULL);
+    for (int i = 0; i < 3; i++)
+        rel[i] = def->position[i] - def->target[i];
+    for (int i = 0; i < 3; i++) {
+        cam.target[i] = c[i];
+        cam.position[i] = c[i];
+        cam.up[i] = 0;
+        for (int k = 0; k < 3; k++) {
+            cam.position[i] += R[3 * i + k] * rel[k];
+            cam.up[i] += R[3 * i + k] * def->up[k];
+        }
+    }
+    return cam;
 }
 
 void cs_scene_render_centre(const cs_scene_render *sr, double t, const cs_frame_cloths *cloths,
@@ -280,7 +298,8 @@ void cs_scene_render_centre(const cs_scene_render *sr, double t, const cs_frame_
 {
     double lo[3], hi[3];
     if (!content_bounds(sr, t, cloths, lo, hi)) {
-        memcpy(centre, sr->camera.target, 3 * sizeof *centre);
+        cs_render_camera cam = cs_scene_render_camera(sr, t);
+        memcpy(centre, cam.target, 3 * sizeof *centre);
         return;
     }
     for (int i = 0; i < 3; i++)
@@ -292,8 +311,11 @@ int cs_scene_render_draw(cs_scene_render *sr, double t, const cs_frame_cloths *c
                          cs_render_stats *stats, char *err, size_t errlen)
 {
     const cs_scene *s = sr->scene;
-    if (!camera)
-        camera = &sr->camera;
+    cs_render_camera at_t;
+    if (!camera) {
+        at_t = cs_scene_render_camera(sr, t);
+        camera = &at_t;
+    }
     char name[64];
 
     /* A camera inside a body would see its inside or nothing: say which. */

@@ -17,7 +17,8 @@ typedef struct cs_scene_render cs_scene_render;
 /* Checks that every cloth has triangles, creates the renderer and fixes the
  * camera: the scene's, or one framing the initial state (cloths at rest
  * where the scene puts them, bodies at t = 0, and their shadow on each
- * ground plane), so every frame of a scene is seen from the same place.
+ * ground plane), so every frame of a scene is seen from the same place
+ * (or, with the scene's camera.motion, from where it carries the camera).
  * warn (may be NULL) hears about bodies that cannot be drawn. On failure
  * returns NULL, a message in err and the exit status in *status. */
 cs_scene_render *cs_scene_render_create(const cs_scene *scene,
@@ -25,7 +26,9 @@ cs_scene_render *cs_scene_render_create(const cs_scene *scene,
                                         char *err, size_t errlen, int *status);
 void cs_scene_render_destroy(cs_scene_render *sr);
 
-const cs_render_camera *cs_scene_render_camera(const cs_scene_render *sr);
+/* The camera at time t: the fixed one, carried by the scene's
+ * camera.motion when it has one. */
+cs_render_camera cs_scene_render_camera(const cs_scene_render *sr, double t);
 
 /* The cloths of one frame, the first of these that is not NULL:
  *   x:      per cloth its positions, in the scene's vertex order (the
@@ -43,7 +46,7 @@ typedef struct cs_frame_cloths {
 void cs_scene_render_centre(const cs_scene_render *sr, double t, const cs_frame_cloths *cloths,
                             double centre[3]);
 
-/* Draws the frame at time t through camera (NULL: the fixed camera) into
+/* Draws the frame at time t through camera (NULL: the scene's at t) into
  * image. Returns an exit status (0, 2 bad input such as a camera inside a
  * body or seeing nothing, 4 failure) with a message in err. */
 int cs_scene_render_draw(cs_scene_render *sr, double t, const cs_frame_cloths *cloths,

@@ -272,6 +272,8 @@ typedef struct cs_camera_def {
     double target[3];
     double up[3];
     double fov_degrees;        /* vertical field of view */
+    cs_motion motion;          /* frame at target, no rotation at t = 0;
+                                  carries the eye, target and up over time */
 } cs_camera_def;
 
 /* A body made from a mesh: what was read, and the grid made of it. */

@@ -353,7 +353,8 @@ static int convert_camera(loader *L, const cs_raw_camera *c, cs_camera_def *cam)
     if (!(lc > 1e-9 * lu * ld))
         return cs_sl_fail(L, "camera.up", false,
                           "must be nonzero and not along the view direction (target - position)");
-    return CS_IMPORT_OK;
+    return cs_sl_convert_motion(L, c->motion, "camera.motion", cam->target,
+                                (const double[4]){1, 0, 0, 0}, &cam->motion);
 }
 
 /* "dir/name.yaml" -> "name". */
@@ -476,6 +477,7 @@ void cs_scene_destroy(cs_scene *s)
         free((void *)s->def.bodies[b].motion.keys);
     }
     free((void *)s->def.bodies);
+    free((void *)s->camera.motion.keys);
     for (int b = 0; s->mesh_bodies && b < s->def.nbodies; b++) {
         cs_scene_mesh_body *mb = &s->mesh_bodies[b];
         if (mb->sign_mesh != mb->mesh)

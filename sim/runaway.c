@@ -6,13 +6,14 @@
  * scene, the time and the scripts' lag (state every rank shares and a resume
  * restores), so it is the same on every rank and after a resume:
  *
- *   limit(t) = 10 (v0 + |g| t + body(t) + script(t) + |wind| + |boost|) + c / 4 + 1 m/s
+ *   limit(t) = 10 (v0 + |g| t + body(t) + script(t) + wind) + c / 4 + 1 m/s
  *
  * v0 the fastest initial velocity; |g| t what gravity can give since the
  * start; body(t) and script(t) the fastest surface point of a moving body
  * or a scripted vertex set so far, |v| + |w| r over its extent (cloth keeps
  * what a driver gave it after the driver stops; a held script's at its own,
- * lagging clock); c the fastest elastic wave, sqrt(E L0 / m) over the edge
+ * lagging clock); wind the fastest the wind can blow (cs_wind_max_speed);
+ * c the fastest elastic wave, sqrt(E L0 / m) over the edge
  * springs: a stretch of strain e released sends its ends back at e c, and
  * cloth that was stretched by a quarter is far beyond Table 1's (stiff
  * cloth, c of hundreds of m/s). The factor 10 leaves room for whips and
@@ -83,7 +84,7 @@ double cs_runaway_limit(const cs_sim *sim, double t)
 {
     double drive = sim->runaway.initial_speed + cs_norm(sim->def.gravity) * fabs(t);
     if (sim->def.wind_enabled)
-        drive += cs_norm(sim->def.wind.velocity) + cs_norm(sim->def.wind.ground_boost);
+        drive += cs_wind_max_speed(&sim->def.wind);
     /* a script step C held back runs behind its keys (its lag, the same on
      * every rank and restored on resume) and catches up faster: its speed
      * then is that of its own clock, times the catch-up rate. Taking the

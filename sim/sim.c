@@ -53,6 +53,8 @@ cs_sim_def cs_default_sim_def(void)
     d.bodies_enabled = true;
     d.wind_enabled = false;
     d.wind.ground_height = 1;
+    d.wind.gust_length = 1;
+    d.wind.gust_period = 2;
     d.self = cs_default_self_collision_def();
     d.comm = CS_COMM_WORLD;
     return d;
@@ -104,6 +106,11 @@ static int validate(const cs_sim_def *def, char *err, size_t errlen)
         return fail(err, errlen, "wind drag must be >= 0 and its velocities finite");
     if (!(def->wind.ground_height > 0) || !isfinite(def->wind.ground_height))
         return fail(err, errlen, "wind ground_height must be > 0 and finite");
+    if (!(def->wind.gust >= 0) || !isfinite(def->wind.gust) || !(def->wind.gust_length > 0) ||
+        !isfinite(def->wind.gust_length) || !(def->wind.gust_period > 0) ||
+        !isfinite(def->wind.gust_period))
+        return fail(err, errlen,
+                    "wind gust must be >= 0, gust_length and gust_period > 0, all finite");
     for (int c = 0; c < def->ncloths; c++) {
         const cs_cloth_def *cl = def->cloths + c;
         const cs_cloth_material *m = &cl->material;

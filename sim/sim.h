@@ -245,26 +245,30 @@ typedef enum cs_friction_method {
 } cs_friction_method;
 
 /* Linear drag along the normal (Section 8): each vertex feels
- * F = -drag * area_i * ((v - wind(y)) . n) n, with area_i a third of the
- * area of its triangles, so drag has units N s / m^3. The paper keeps "a
- * high wind speed near the ground" for its falling leaves:
- * wind(y) = velocity + ground_boost * max(0, 1 - y / ground_height), so the
- * wind differs across a leaf and turns and bends it. */
+ * F = -drag * area_i * ((v - wind(p, t)) . n) n, with area_i a third of the
+ * area of its triangles, so drag has units N s / m^3. A uniform wind only
+ * carries a leaf: the drag's centre is its centre of mass, so nothing turns
+ * it. The paper's leaves "flutter" because their wind differs across them:
+ * it keeps "a high wind speed near the ground" (ground_boost, fading
+ * linearly to none at ground_height), and a scene may add gusts, an
+ * Arnold-Beltrami-Childress flow (divergence-free, like air at these
+ * speeds) of wavelength gust_length whose phases drift with gust_period;
+ * gust is the RMS of each of its components. */
 typedef struct cs_wind_def {
     double velocity[3];
     double drag;
     double ground_boost[3];  /* added at y <= 0, fading to 0 at ground_height */
     double ground_height;    /* m, > 0 (default 1) */
+    double gust;             /* m/s, >= 0 (default 0: no gusts) */
+    double gust_length;      /* m, > 0 (default 1) */
+    double gust_period;      /* s, > 0 (default 2) */
 } cs_wind_def;
 
-/* The wind at height y (the +y axis is up in every scene). */
-static inline void cs_wind_at(const cs_wind_def *w, double y, double out[3])
-{
-    double f = 1 - y / w->ground_height;
-    f = f < 0 ? 0 : f > 1 ? 1 : f;
-    for (int d = 0; d < 3; d++)
-        out[d] = w->velocity[d] + f * w->ground_boost[d];
-}
+/* The wind at point p and time t (the +y axis is up in every scene). */
+void cs_wind_at(const cs_wind_def *w, const double p[3], double t, double out[3]);
+
+/* The fastest wind cs_wind_at can give anywhere, at any time. */
+double cs_wind_max_speed(const cs_wind_def *w);
 
 /* Self-collision (Sections 4 and 5). Defaults from Table 1. */
 typedef enum cs_collision_scheme {

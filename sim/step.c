@@ -108,10 +108,40 @@ static void wind_geometry(cs_sim *sim, const double *x)
     }
 }
 
-/* force = elastic(x) + m g + explicit wind part, and the solve's right-hand
- * side rhs = M v_start + (dt / 2) force, for owned particles (the ghosts'
- * forces are zero); one threaded pass after the springs' */
-static void explicit_forces(cs_sim *sim, const double *x, const double *v_start)
+/* The ABC flow's phases advance at these multiples of 2 pi / gust_period:
+ * ratios far from simple fractions, so the pattern never repeats exactly. */
+static const double GUST_RATE[3] = {1.0, 0.6180339887498949, 0.4142135623730951};
+
+void cs_wind_at(const cs_wind_def *w, const double p[3], double t, double out[3])
+{
+    double f = 1 - p[1] / w->ground_height;
+    f = f < 0 ? 0 : f > 1 ? 1 : f;
+    for (int d = 0; d < 3; d++)
+        out[d] = w->velocity[d] + f * w->ground_boost[d];
+    if (!(w->gust > 0))
+        return;
+    /* u = A (sin(kz + a_z) + cos(ky + a_y), sin(kx + a_x) + cos(kz + a_z),
+     *        sin(ky + a_y) + cos(kx + a_x)): each component depends only on
+     * the other two coordinates, so div u = 0; each is the sum of two
+     * unit-amplitude waves, so its RMS over space is A. */
+    double k = 2 * M_PI / w->gust_length, s = 2 * M_PI * t / w->gust_period, arg[3];
+    for (int d = 0; d < 3; d++)
+        arg[d] = k * p[d] + GUST_RATE[d] * s;
+    out[0] += w->gust * (sin(arg[2]) + cos(arg[1]));
+    out[1] += w->gust * (sin(arg[0]) + cos(arg[2]));
+    out[2] += w->gust * (sin(arg[1]) + cos(arg[0]));
+}
+
+double cs_wind_max_speed(const cs_wind_def *w)
+{
+    /* each gust component is at most 2 A */
+    return cs_norm(w->velocity) + cs_norm(w->ground_boost) + 2 * sqrt(3.0) * w->gust;
+}
+
+/* force = elastic(x) + m g + explicit wind part at time t, and the solve's
+ * right-hand side rhs = M v_start + (dt / 2) force, for owned particles
+ * (the ghosts' forces are zero); one threaded pass after the springs' */
+static void explicit_forces(cs_sim *sim, const double *x, const double *v_start, double t)
 {
     CS_PARALLEL_FOR_LOCAL(sim->par, i)
         sim->force[3 * i] = sim->force[3 * i + 1] = sim->force[3 * i + 2] = 0;
@@ -123,7 +153,7 @@ static void explicit_forces(cs_sim *sim, const double *x, const double *v_start)
         if (sim->wind_normal) {
             const double *nrm = sim->wind_normal + 3 * i;
             double wind[3];
-            cs_wind_at(&sim->def.wind, x[3 * i + 1], wind);
+            cs_wind_at(&sim->def.wind, x + 3 * i, t, wind);
             cs_axpy(c * sim->wind_area[i] * cs_dot(nrm, wind), nrm, f);
         }
         for (int d = 0; d < 3; d++)
@@ -199,7 +229,7 @@ static const double *stage_velocity_half(cs_sim *sim, const step_state *st)
         if (!sim->is_free[i])
             for (int d = 0; d < 3; d++)
                 sim->v0[3 * i + d] = (sim->script_x[3 * i + d] - sim->x[3 * i + d]) / st->dt;
-    explicit_forces(sim, sim->x, sim->v); /* prepares the springs' directions at x^n too */
+    explicit_forces(sim, sim->x, sim->v, sim->t); /* prepares the springs' directions at x^n too */
     sim->cg_iterations += cs_cg_solve(sim, sim->v0, sim->rhs, sim->v_half, sim->cg.warm_half,
                                       sim->cg.warm_half_before);
     return sim->v_half;
@@ -251,7 +281,7 @@ static const double *stage_velocity_full(cs_sim *sim, const step_state *st)
     CS_PARALLEL_FOR_LOCAL(par, i) /* x^(n+1/2), reusing v_half */
         for (int d = 0; d < 3; d++)
             sim->v_half[3 * i + d] = 0.5 * (sim->x_prev[3 * i + d] + sim->x[3 * i + d]);
-    explicit_forces(sim, sim->v_half, sim->v_star); /* and at x^(n+1/2) */
+    explicit_forces(sim, sim->v_half, sim->v_star, st->t1 - 0.5 * st->dt); /* at x^(n+1/2) */
     double *v_p = sim->v0; /* v0 is free again */
     copy_ranges(par->own, par->nown, sim->cg.b, sim->v_star);
     sim->cg_iterations += cs_cg_solve(sim, sim->cg.b, sim->rhs, v_p, sim->cg.warm_full,

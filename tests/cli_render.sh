@@ -200,6 +200,14 @@ err_has "below the plane of body 'ground'"
 run 2 render sim --frames 0 --set 'camera={position: [0, 3, 0], target: [0, 5, 0], up: [1, 0, 0]}'
 err_has "sees nothing"
 [ ! -e sim/images/frame_0000.png.tmp ] || fail "a half-written image was left"
+# a camera carried by camera.motion: at frame 0 where the scene puts it, by
+# frame 2 (t = 0.083 s) turned 170 degrees about x around its target, under
+# the ground; the images are drawn from where the motion has taken it
+TURN='camera={position: [0, 1, 3], target: [0, 0.4, 0], motion: {keys: [{time: 0}, {time: 0.05, rotate: [170, 0, 0]}]}}'
+run 0 render sim --frames 0 --size 40x30 --samples 1 -q -o moving --set "$TURN"
+check_png moving/frame_0000.png 40x30
+run 2 render sim --frames 2 --size 40x30 --samples 1 -q -o moving --set "$TURN"
+err_has "below the plane of body 'ground'"
 # run --render finds a bad camera before simulating
 run 2 run tiny.yaml -q -o blind --render embree --set 'camera={position: [0, 3, 0], target: [0, 5, 0], up: [1, 0, 0]}'
 err_has "sees nothing"

@@ -97,6 +97,9 @@ static const char *full_scene =
     "wind:\n"
     "  velocity: [1, 0, 0]\n"
     "  drag: 0.5\n"
+    "  gust: 0.3\n"
+    "  gust_length: 0.4\n"
+    "  gust_period: 0.7\n"
     "output:\n"
     "  format: glb\n"
     "camera:\n"
@@ -104,6 +107,7 @@ static const char *full_scene =
     "  target: [0, 0.5, 0]\n"
     "  up: [0, 0, 1]\n"
     "  fov: 35\n"
+    "  motion: {keys: [{time: 0}, {time: 2, translate: [1, 0, 0], rotate: [0, 90, 0]}]}\n"
     "cloths:\n"
     "  - name: sheet\n"
     "    color: [0.1, 0.2, 0.3]\n"
@@ -173,6 +177,15 @@ static void test_full_scene_values(void **state)
     assert_vec(s->camera.target, 0, 0.5, 0);
     assert_vec(s->camera.up, 0, 0, 1);
     assert_true(fabs(s->camera.fov_degrees - 35) < EPS);
+    /* the camera's motion: its frame starts at the target, unrotated */
+    assert_int_equal(s->camera.motion.kind, CS_MOTION_KEYFRAMES);
+    assert_int_equal(s->camera.motion.nkeys, 2);
+    assert_vec(s->camera.motion.position, 0, 0.5, 0);
+    assert_vec(s->camera.motion.keys[1].position, 1, 0.5, 0);
+    assert_true(fabs(s->camera.motion.keys[1].rotation[0] - sqrt(0.5)) < EPS &&
+                fabs(s->camera.motion.keys[1].rotation[2] - sqrt(0.5)) < EPS);
+    assert_true(fabs(d->wind.gust - 0.3) < EPS && fabs(d->wind.gust_length - 0.4) < EPS &&
+                fabs(d->wind.gust_period - 0.7) < EPS);
 
     assert_true(fabs(d->fps - 30) < EPS);
     assert_true(fabs(d->dt - 0.002) < EPS);
@@ -557,6 +570,18 @@ static void test_error_out_of_range(void **state)
                             "scenes/a.yaml:3: wind.drag: must be >= 0 (got -2)");
     expect_error_after_grid("camera: {position: [0, 0, 1], target: [0, 0, 0], fov: 180}\n",
                             "scenes/a.yaml:3: camera.fov: must be in (0, 180) (got 180)");
+    expect_error_after_grid("camera: {position: [0, 0, 1], target: [0, 0, 0],\n"
+                            "         motion: {velocity: [1, 0, 0], keys: [{time: 0}]}}\n",
+                            "scenes/a.yaml:4: camera.motion: expected either "
+                            "velocity/angular_velocity or keys (got both)");
+    expect_error_after_grid("camera: {position: [0, 0, 1], target: [0, 0, 0],\n"
+                            "         motion: {keys: [{time: 1}, {time: 1}]}}\n",
+                            "scenes/a.yaml:4: camera.motion.keys[1].time: must be greater than "
+                            "the previous key's time 1 (got 1)");
+    expect_error_after_grid("wind: {drag: 1, gust: -0.1}\n",
+                            "scenes/a.yaml:3: wind.gust: must be >= 0 (got -0.1)");
+    expect_error_after_grid("wind: {drag: 1, gust_length: 0}\n",
+                            "scenes/a.yaml:3: wind.gust_length: must be > 0 (got 0)");
     expect_error("cloths:\n  - grid: {size: [1, 0]}\n", 0, NULL,
                  "scenes/a.yaml:2: cloths[0].grid.size[1]: must be > 0 (got 0)");
     expect_error("cloths:\n  - grid: {resolution: [0, 2]}\n", 0, NULL,

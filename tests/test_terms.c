@@ -39,6 +39,8 @@
  *  wind drag (area), wind   t wind_velocity_drag: v 0.534 and 0.544, exact 0.4945
  *    velocity
  *  wind ground_boost       t wind_ground_boost: y 0.215170 at t = 0.05, exact 0.212984
+ *  wind gust (amplitude)    t wind_gust_drives_sheet: V -0.0072911 at t = 0.014, exact -0.0066307
+ *  gust phase rate          t wind_gust_drives_sheet: V 0.0017346 at t = 0.006, exact 0.0022202
  *  body friction mu         t impact_friction_thrown_particle: vx 1.6766, exact 1.706;
  *                           i every case (the paper's: 474x the position tolerance)
  *  repulsion k              s Eq. 1 spring branch 1.094 of the rise, edge/edge 1.1
@@ -525,6 +527,24 @@ static void test_impact_friction_thrown_particle(void **state)
 
 /* ----------------------------------------------------------------- wind */
 
+/* A level square sheet of `side` m and res x res quads centred at center,
+ * density rho, in drag cd (no wind velocity yet): cloth->mesh is the
+ * caller's to destroy, and cloth must outlive the definition. */
+static cs_sim_def wind_sheet_def(double side, int res, const double center[3], double rho,
+                                 double cd, double dt, double fps, cs_cloth_def *cloth)
+{
+    double size[2] = {side, side}, q[4] = {1, 0, 0, 0};
+    int r[2] = {res, res};
+    *cloth = (cs_cloth_def){.name = "sheet",
+                            .mesh = cs_trimesh_create_grid(size, r, q, center),
+                            .material = cs_default_cloth_material()};
+    cloth->material.density = rho;
+    cs_sim_def def = bare_def(cloth, dt, fps);
+    def.wind_enabled = true;
+    def.wind.drag = cd;
+    return def;
+}
+
 /* Wind velocity (Section 8): a sheet at rest, no gravity, in a wind with
  * a normal part wn and a tangential part. The drag acts along the normal
  * only, on area A_i, and the mass is rho A_i, so every vertex follows
@@ -533,15 +553,9 @@ static void test_impact_friction_thrown_particle(void **state)
 static void test_wind_velocity_drag(void **state)
 {
     (void)state;
-    double size[2] = {1, 1}, q[4] = {1, 0, 0, 0}, center[3] = {0, 0, 0};
-    int res[2] = {4, 4};
-    cs_trimesh *mesh = cs_trimesh_create_grid(size, res, q, center);
-    cs_cloth_def cloth = {.name = "sheet", .mesh = mesh, .material = cs_default_cloth_material()};
     const double rho = 0.1, cd = 2.0, wn = 1.5;
-    cloth.material.density = rho;
-    cs_sim_def def = bare_def(&cloth, 1e-3, 50);
-    def.wind_enabled = true;
-    def.wind.drag = cd;
+    cs_cloth_def cloth;
+    cs_sim_def def = wind_sheet_def(1, 4, (const double[3]){0, 0, 0}, rho, cd, 1e-3, 50, &cloth);
     def.wind.velocity[0] = 3;
     def.wind.velocity[1] = wn;
     def.wind.velocity[2] = -1;
@@ -557,7 +571,7 @@ static void test_wind_velocity_drag(void **state)
         }
     }
     cs_sim_destroy(sim);
-    cs_trimesh_destroy(mesh);
+    cs_trimesh_destroy((cs_trimesh *)cloth.mesh);
 }
 
 /* The wind near the ground (Section 8, Fig. 9's "high wind speed near the
@@ -571,16 +585,10 @@ static void test_wind_velocity_drag(void **state)
 static void test_wind_ground_boost(void **state)
 {
     (void)state;
-    double size[2] = {1, 1}, q[4] = {1, 0, 0, 0}, center[3] = {0, 0.2, 0};
-    int res[2] = {4, 4};
-    cs_trimesh *mesh = cs_trimesh_create_grid(size, res, q, center);
-    cs_cloth_def cloth = {.name = "sheet", .mesh = mesh, .material = cs_default_cloth_material()};
     const double rho = 0.1, cd = 2.0, B = 1.5, H = 1.0, g = 9.8, y0 = 0.2;
-    cloth.material.density = rho;
-    cs_sim_def def = bare_def(&cloth, 1e-4, 20);
+    cs_cloth_def cloth;
+    cs_sim_def def = wind_sheet_def(1, 4, (const double[3]){0, y0, 0}, rho, cd, 1e-4, 20, &cloth);
     def.gravity[1] = -g;
-    def.wind_enabled = true;
-    def.wind.drag = cd;
     def.wind.ground_boost[1] = B;
     def.wind.ground_height = H;
     cs_sim *sim = create(&def);
@@ -607,7 +615,129 @@ static void test_wind_ground_boost(void **state)
     print_message("ground boost: worst |y - exact| %.3g m over 2 s (y* = %.4f m)\n", worst,
                   ystar);
     cs_sim_destroy(sim);
-    cs_trimesh_destroy(mesh);
+    cs_trimesh_destroy((cs_trimesh *)cloth.mesh);
+}
+
+/* The gust field (wind.gust, an ABC flow), checked from its definition:
+ * divergence-free (central differences), each component's RMS over a
+ * wavelength cube equal to `gust`, never faster than cs_wind_max_speed, and
+ * changing with time at the rates the README gives (one phase a period). */
+static void test_wind_gust_field(void **state)
+{
+    (void)state;
+    cs_wind_def w = cs_default_sim_def().wind;
+    w.gust = 0.7;
+    w.gust_length = 0.5;
+    w.gust_period = 1.5;
+    const int n = 16;
+    const double h = 1e-5, L = w.gust_length;
+    double sq[3] = {0, 0, 0}, fastest = 0, worst_div = 0;
+    for (int a = 0; a < n; a++)
+        for (int b = 0; b < n; b++)
+            for (int c = 0; c < n; c++) {
+                double p[3] = {L * a / n, 2 + L * b / n, L * c / n}, u[3], t = 0.3;
+                cs_wind_at(&w, p, t, u);
+                for (int d = 0; d < 3; d++)
+                    sq[d] += u[d] * u[d] / (n * n * n);
+                fastest = fmax(fastest, sqrt(u[0] * u[0] + u[1] * u[1] + u[2] * u[2]));
+                double div = 0;
+                for (int d = 0; d < 3; d++) {
+                    double pp[3] = {p[0], p[1], p[2]}, pm[3] = {p[0], p[1], p[2]}, up[3], um[3];
+                    pp[d] += h;
+                    pm[d] -= h;
+                    cs_wind_at(&w, pp, t, up);
+                    cs_wind_at(&w, pm, t, um);
+                    div += (up[d] - um[d]) / (2 * h);
+                }
+                worst_div = fmax(worst_div, fabs(div));
+            }
+    for (int d = 0; d < 3; d++)
+        if (!(fabs(sqrt(sq[d]) - w.gust) < 1e-9))
+            fail_msg("component %d: RMS %.12f, expected %.12f", d, sqrt(sq[d]), w.gust);
+    /* |div| against the size of one derivative, k A = 2 pi A / L */
+    assert_true(worst_div < 1e-6 * 2 * M_PI * w.gust / L);
+    assert_true(fastest <= cs_wind_max_speed(&w) && fastest > 0.5 * cs_wind_max_speed(&w));
+    /* the phases' rates: at x = z = 0, u_y = A (sin(s) + cos(0.414 s)),
+     * s = 2 pi t / period; at t = 0 it is A, a quarter period on sin is 1 */
+    double o[3] = {0, 2, 0}, u0[3], u1[3];
+    cs_wind_at(&w, o, 0.0, u0);
+    cs_wind_at(&w, o, 0.25 * w.gust_period, u1);
+    assert_true(fabs(u0[1] - w.gust) < 1e-12);
+    assert_true(fabs(u1[1] - w.gust * (1 + cos(0.4142135623730951 * M_PI / 2))) < 1e-12);
+    /* no gust: the old wind, exactly */
+    w.gust = 0;
+    cs_wind_at(&w, o, 0.7, u0);
+    assert_true(u0[0] == 0 && u0[1] == 0 && u0[2] == 0);
+}
+
+/* V(t) of V' = a (sin(theta + omega t) - V), V(0) = 0: the steady response
+ * plus the transient that starts it from rest. */
+static double first_order_sin(double a, double omega, double theta, double t)
+{
+    double k = a / (a * a + omega * omega);
+    return k * (a * sin(theta + omega * t) - omega * cos(theta + omega * t)) -
+           exp(-a * t) * k * (a * sin(theta) - omega * cos(theta));
+}
+
+/* Gusts drive the cloth through the drag: a 1 cm level sheet, no gravity,
+ * in fast gusts alone (period 0.05 s), for 0.02 s. The drag is along the normal (y) and the gusts' y
+ * component at (x, z) is A (sin(k x + s) + cos(k z + r s)), s = 2 pi t / P,
+ * so each vertex is pushed by two sinusoids of its own phase. The springs'
+ * forces cancel in the sum, so the mass-weighted mean velocity follows
+ * rho V' = c (U(t) - V), U the area-weighted mean of the pushes: two
+ * first-order responses per vertex, in closed form. That holds while the
+ * sheet stays level; but the gusts differ across it and turn it (that is
+ * what makes leaves flutter), tilting the drag into the gusts' horizontal
+ * part, an error growing as t^2: 1e-4 m/s at 0.02 s, a quarter of the
+ * tolerance. A 10% change in the gusts' amplitude or phase rate breaks it
+ * (header). */
+static void test_wind_gust_drives_sheet(void **state)
+{
+    (void)state;
+    const double rho = 0.1, cd = 1.0, A = 0.4, L = 0.5, P = 0.05, r = 0.4142135623730951;
+    cs_cloth_def cloth;
+    cs_sim_def def =
+        wind_sheet_def(0.01, 2, (const double[3]){0.13, 0.5, -0.21}, rho, cd, 1e-4, 500, &cloth);
+    const cs_trimesh *mesh = cloth.mesh;
+    def.wind.gust = A;
+    def.wind.gust_length = L;
+    def.wind.gust_period = P;
+    cs_sim *sim = create(&def);
+    int nv = mesh->nv;
+    double *area = calloc((size_t)nv, sizeof *area), total = 0;
+    assert_non_null(area);
+    for (int t = 0; t < mesh->nt; t++) {
+        const int *v = mesh->tri + 3 * t;
+        double e1[3], e2[3];
+        for (int d = 0; d < 3; d++) {
+            e1[d] = mesh->x[3 * v[1] + d] - mesh->x[3 * v[0] + d];
+            e2[d] = mesh->x[3 * v[2] + d] - mesh->x[3 * v[0] + d];
+        }
+        double cx = e1[1] * e2[2] - e1[2] * e2[1], cy = e1[2] * e2[0] - e1[0] * e2[2],
+               cz = e1[0] * e2[1] - e1[1] * e2[0], a = 0.5 * sqrt(cx * cx + cy * cy + cz * cz);
+        for (int k = 0; k < 3; k++)
+            area[v[k]] += a / 3;
+        total += a;
+    }
+    double a = cd / rho, k = 2 * M_PI / L, omega = 2 * M_PI / P, worst = 0;
+    for (int f = 1; f <= 10; f++) {
+        advance(sim);
+        double t = cs_sim_time(sim), exact = 0, mean = 0;
+        for (int i = 0; i < nv; i++) {
+            const double *x0 = mesh->x + 3 * i;
+            exact += area[i] / total * A *
+                     (first_order_sin(a, omega, k * x0[0], t) +
+                      first_order_sin(a, r * omega, k * x0[2] + M_PI / 2, t));
+            mean += area[i] / total * cs_sim_velocities(sim)[3 * i + 1];
+        }
+        worst = fmax(worst, fabs(mean - exact));
+        if (!(fabs(mean - exact) < 1e-3 * A))
+            fail_msg("t=%.3f: mean v_y %.7f, exact %.7f", t, mean, exact);
+    }
+    print_message("gusts: worst |V - exact| %.3g m/s over 0.02 s (A = %.2f m/s)\n", worst, A);
+    free(area);
+    cs_sim_destroy(sim);
+    cs_trimesh_destroy((cs_trimesh *)cloth.mesh);
 }
 
 /* ------------------------------------------------------------ the solver */
@@ -782,6 +912,8 @@ int main(void)
         cmocka_unit_test(test_impact_friction_thrown_particle),
         cmocka_unit_test(test_wind_velocity_drag),
         cmocka_unit_test(test_wind_ground_boost),
+        cmocka_unit_test(test_wind_gust_field),
+        cmocka_unit_test(test_wind_gust_drives_sheet),
         cmocka_unit_test(test_cg_tolerance_is_met),
         cmocka_unit_test(test_script_release),
     };
