@@ -7,12 +7,13 @@
 
 #define BAR_WIDTH 20
 
-void cs_progress_init(cs_progress *p, FILE *out, bool quiet, int total_frames)
+void cs_progress_init(cs_progress *p, FILE *out, bool quiet, int first_frame, int total_frames)
 {
     memset(p, 0, sizeof *p);
     p->out = out;
     p->enabled = !quiet && out != NULL;
     p->tty = p->enabled && isatty(fileno(out));
+    p->first = first_frame;
     p->total = total_frames;
 }
 
@@ -33,19 +34,20 @@ void cs_format_duration(double seconds, char *buf, size_t len)
 
 void cs_progress_frame(cs_progress *p, int frame, double sim_time, double elapsed)
 {
-    if (!p->enabled || (frame == 0 && !p->tty))
+    if (!p->enabled || (frame == p->first && !p->tty))
         return;
-    double per_frame = frame > 0 ? elapsed / frame : NAN;
+    /* a resumed run's earlier frames took no time in this process */
+    double per_frame = frame > p->first ? elapsed / (frame - p->first) : NAN;
     int left = p->total - frame;
     char eta[32];
     cs_format_duration(left > 0 ? per_frame * left : 0.0, eta, sizeof eta);
 
     char text[160];
-    if (frame > 0)
+    if (frame > p->first)
         snprintf(text, sizeof text, "frame %d/%d  t=%.3f s  %.3g s/frame  ETA %s",
                  frame, p->total, sim_time, per_frame, eta);
     else
-        snprintf(text, sizeof text, "frame 0/%d  t=%.3f s  -- s/frame  ETA --",
+        snprintf(text, sizeof text, "frame %d/%d  t=%.3f s  -- s/frame  ETA --", frame,
                  p->total, sim_time);
 
     if (!p->tty) {

@@ -16,16 +16,18 @@ typedef struct cs_progress {
     bool enabled;
     bool tty;           /* redraw one line instead of printing lines */
     bool line_open;     /* a redrawn line is on screen without its newline */
-    int total;          /* frames to simulate */
+    int total;          /* the run's last frame */
+    int first;          /* the frame this process starts after (a resume's) */
     int last_len;       /* length of the line on screen, to blank leftovers */
 } cs_progress;
 
-/* Shows progress on out unless quiet; tty decides the style. */
-void cs_progress_init(cs_progress *p, FILE *out, bool quiet, int total_frames);
+/* Shows progress on out unless quiet; tty decides the style. The rate and
+ * the ETA count the frames after first_frame (0, or where a resume starts). */
+void cs_progress_init(cs_progress *p, FILE *out, bool quiet, int first_frame, int total_frames);
 
 /* Frame `frame` of total is done at simulated time sim_time (s); elapsed is
  * the wall time (s) spent on the frames so far, for the rate and the ETA.
- * Frame 0 (before any is simulated) shows the empty bar on a terminal only. */
+ * The first frame (before any is simulated) shows the bar on a terminal only. */
 void cs_progress_frame(cs_progress *p, int frame, double sim_time, double elapsed);
 
 /* Ends a redrawn line so that other messages start on a fresh one. */

@@ -490,7 +490,7 @@ static int simulate(run_state *r, const run_options *o)
     }
 
     cs_progress progress;
-    cs_progress_init(&progress, stderr, o->quiet || !root, r->scene->frames);
+    cs_progress_init(&progress, stderr, o->quiet || !root, r->first_frame, r->scene->frames);
 
     cs_sim_state_gather(r->sim);
     if (root) {

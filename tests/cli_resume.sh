@@ -103,6 +103,12 @@ n=$(($(grep -c . killed/frames.jsonl) + 2))
 [ "$n" -ge 10 ] || n=10
 run 0 run "$DRAPE" -o killed --set "$SMALL" --frames "$n" --resume
 err_has "resuming killed after frame [0-9]+"
+# the progress counts this process's frames: its first line is the frame
+# after the resumed one (it once showed that frame at "0 s/frame", and a
+# rate divided by every frame since the start)
+k=$(sed -n 's/.*resuming killed after frame \([0-9]*\).*/\1/p' err.txt)
+first=$(grep -m1 -o "^frame [0-9]*/" err.txt || true)
+[ "$first" = "frame $((k + 1))/" ] || fail "the resumed progress starts with '$first', expected frame $((k + 1))"
 if [ "$n" -gt 10 ]; then
     run 0 run "$DRAPE" -q -o ref --set "$SMALL" --frames "$n"
 fi
