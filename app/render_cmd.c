@@ -593,7 +593,8 @@ static int render_turntable(job *j, int f)
     }
     for (int k = 0; k < n && status == CS_EXIT_OK; k++) {
         double angle = 2 * M_PI * k / n;
-        cs_render_camera view = cs_render_camera_orbit(&cam, centre, cam.up, angle);
+        cs_render_camera view =
+            cs_render_camera_orbit(&cam, centre, cs_scene_render_up(j->sr), angle);
         cs_render_stats st;
         status = cs_scene_render_draw(j->sr, t, &j->geom.cloths, &view, j->image, &st, err,
                                       sizeof err);

@@ -270,6 +270,8 @@ void cs_scene_render_destroy(cs_scene_render *sr)
     free(sr);
 }
 
+const double *cs_scene_render_up(const cs_scene_render *sr) { return sr->camera.up; }
+
 cs_render_camera cs_scene_render_camera(const cs_scene_render *sr, double t)
 {
     cs_render_camera cam = sr->camera;

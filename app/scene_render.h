@@ -30,6 +30,11 @@ void cs_scene_render_destroy(cs_scene_render *sr);
  * camera.motion when it has one. */
 cs_render_camera cs_scene_render_camera(const cs_scene_render *sr, double t);
 
+/* The scene's up direction as given (or the automatic camera's): the axis
+ * turntables orbit, so a camera the motion has tilted still circles the
+ * scene level. */
+const double *cs_scene_render_up(const cs_scene_render *sr);
+
 /* The cloths of one frame, the first of these that is not NULL:
  *   x:      per cloth its positions, in the scene's vertex order (the
  *           scene's triangles apply), as the simulation holds them;

@@ -208,6 +208,12 @@ run 0 render sim --frames 0 --size 40x30 --samples 1 -q -o moving --set "$TURN"
 check_png moving/frame_0000.png 40x30
 run 2 render sim --frames 2 --size 40x30 --samples 1 -q -o moving --set "$TURN"
 err_has "below the plane of body 'ground'"
+# a camera the motion tilts 40 degrees down still orbits level in a
+# turntable (about the scene's up, not its own tilted one, which took the
+# far views under the ground)
+TILT='camera={position: [0, 1, 3], target: [0, 0.4, 0], motion: {keys: [{time: 0, rotate: [-40, 0, 0]}]}}'
+run 0 render sim --frames 0 --turntable 4 --size 40x30 --samples 1 -q -o tilted --set "$TILT"
+check_png tilted/view_002.png 40x30
 # run --render finds a bad camera before simulating
 run 2 run tiny.yaml -q -o blind --render embree --set 'camera={position: [0, 3, 0], target: [0, 5, 0], up: [1, 0, 0]}'
 err_has "sees nothing"
