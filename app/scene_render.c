@@ -28,6 +28,13 @@ struct cs_scene_render {
     double edge;                /* longest cloth edge at rest, m */
 };
 
+/* out = c + R p: a point of a moving frame (cs_motion_pose) in the world. */
+static void posed(const double R[9], const double c[3], const double p[3], double out[3])
+{
+    for (int i = 0; i < 3; i++)
+        out[i] = c[i] + R[3 * i] * p[0] + R[3 * i + 1] * p[1] + R[3 * i + 2] * p[2];
+}
+
 /* The body as drawn: a little smaller than the one the cloth collides with.
  * Cloth vertices rest on the true surface, but a flat triangle between them
  * is a chord that dips into a curved body by up to L^2 / (8 r), and the
@@ -113,12 +120,8 @@ static cs_trimesh *solid_at(const cs_scene_render *sr, int b, double t, int deta
         return NULL;
     double R[9], c[3];
     cs_motion_pose(&body->motion, t, R, c, NULL, NULL);
-    for (int v = 0; v < local->nv; v++) {
-        const double *p = local->x + 3 * (size_t)v;
-        for (int i = 0; i < 3; i++)
-            m->x[3 * (size_t)v + i] = c[i] + R[3 * i] * p[0] + R[3 * i + 1] * p[1] +
-                                      R[3 * i + 2] * p[2];
-    }
+    for (int v = 0; v < local->nv; v++)
+        posed(R, c, local->x + 3 * (size_t)v, m->x + 3 * (size_t)v);
     memcpy(m->tri, local->tri, 3 * (size_t)local->nt * sizeof *m->tri);
     return m;
 }
@@ -283,15 +286,9 @@ cs_render_camera cs_scene_render_camera(const cs_scene_render *sr, double t)
     cs_motion_pose(&def->motion, t, R, c, NULL, NULL);
     for (int i = 0; i < 3; i++)
         rel[i] = def->position[i] - def->target[i];
-    for (int i = 0; i < 3; i++) {
-        cam.target[i] = c[i];
-        cam.position[i] = c[i];
-        cam.up[i] = 0;
-        for (int k = 0; k < 3; k++) {
-            cam.position[i] += R[3 * i + k] * rel[k];
-            cam.up[i] += R[3 * i + k] * def->up[k];
-        }
-    }
+    memcpy(cam.target, c, sizeof cam.target);
+    posed(R, c, rel, cam.position);
+    posed(R, (const double[3]){0, 0, 0}, def->up, cam.up);
     return cam;
 }
 
