@@ -3,6 +3,7 @@
  * (Section 7). Step C is in selfcol_collide.c. */
 #include <float.h>
 #include <math.h>
+#include <omp.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -72,6 +73,7 @@ cs_selfcol *cs_selfcol_create(const cs_sim *sim)
         nt += sim->cloths[c].mesh->nt;
     sc->n = n;
     sc->nt = nt;
+    sc->use_start_gap = true;
     sc->tri = malloc(sizeof *sc->tri * 3 * (size_t)(nt + 1));
     int *e = malloc(sizeof *e * 6 * (size_t)(nt + 1));
     if (!sc->tri || !e)
@@ -590,33 +592,45 @@ static bool may_meet(const finder *f, const int v[4], int split, double dist)
 /* The makers below turn a candidate (a, b) of a traversal into a pair
  * (pair_maker, selfcol_private.h). */
 
+/* The makers measure every pair step C could find (wings and pairs of
+ * held particles too, which step A itself leaves out), for start_gap. */
+static void note_distance(const finder *f, double dist)
+{
+    cs_made_list *mine = f->sc->made + omp_get_thread_num();
+    if (!(dist >= mine->nearest)) /* NaN too: then step C skips nothing */
+        mine->nearest = dist;
+}
+
 static bool make_repulsion_point_triangle(const void *ctx, int point, int t, cs_pair *out)
 {
     const finder *f = ctx;
     const cs_selfcol *sc = f->sc;
     const int *tri = sc->tri + 3 * t;
-    if (point == tri[0] || point == tri[1] || point == tri[2] || wing_pair(sc, point, tri))
+    if (point == tri[0] || point == tri[1] || point == tri[2])
         return false;
     int quad[4] = {tri[0], tri[1], tri[2], point};
     if (sc_pair_rank(f->sim->par, quad) != f->sim->par->rank)
         return false; /* another rank's to find */
+    const double *x = sc->x_free;
+    double w[3];
+    double dist = cs_point_triangle_closest(x + 3 * point, x + 3 * tri[0], x + 3 * tri[1],
+                                            x + 3 * tri[2], w);
+    note_distance(f, dist);
+    if (wing_pair(sc, point, tri))
+        return false;
     if (sc->inv_mass[point] == 0 && sc->inv_mass[tri[0]] == 0 && sc->inv_mass[tri[1]] == 0 &&
         sc->inv_mass[tri[2]] == 0)
         return false;
+    int v[4] = {tri[0], tri[1], tri[2], point};
+    if (!may_meet(f, v, 3, dist))
+        return false;
     /* history: wind the triangle so its normal points at the free point
      * (the paper's reordering; swapping two triangle vertices flips it) */
-    const double *x = sc->x_free;
     double e1[3], e2[3], nrm[3], r[3];
     cs_sub(x + 3 * tri[1], x + 3 * tri[0], e1);
     cs_sub(x + 3 * tri[2], x + 3 * tri[0], e2);
     cs_cross(e1, e2, nrm);
     cs_sub(x + 3 * point, x + 3 * tri[0], r);
-    int v[4] = {tri[0], tri[1], tri[2], point};
-    double w[3];
-    double dist = cs_point_triangle_closest(x + 3 * point, x + 3 * tri[0], x + 3 * tri[1],
-                                            x + 3 * tri[2], w);
-    if (!may_meet(f, v, 3, dist))
-        return false;
     double side = cs_dot(nrm, r);
     if (fabs(side) <= 1e-12 * cs_norm(nrm) * (cs_norm(r) + cs_norm(e1)))
         side = sc_ring_side(sc, x, point, nrm); /* in the plane: ambiguous */
@@ -639,12 +653,13 @@ static bool make_repulsion_edge_edge(const void *ctx, int ea, int eb, cs_pair *o
     int quad[4] = {a[0], a[1], b[0], b[1]};
     if (sc_pair_rank(f->sim->par, quad) != f->sim->par->rank)
         return false; /* another rank's to find */
+    const double *x = sc->x_free;
+    double s, t, s0[3];
+    note_distance(f, cs_segment_segment_closest(x + 3 * a[0], x + 3 * a[1], x + 3 * b[0],
+                                                x + 3 * b[1], &s, &t));
     if (sc->inv_mass[a[0]] == 0 && sc->inv_mass[a[1]] == 0 && sc->inv_mass[b[0]] == 0 &&
         sc->inv_mass[b[1]] == 0)
         return false;
-    const double *x = sc->x_free;
-    double s, t, s0[3];
-    cs_segment_segment_closest(x + 3 * a[0], x + 3 * a[1], x + 3 * b[0], x + 3 * b[1], &s, &t);
     for (int k = 0; k < 3; k++)
         s0[k] = (x[3 * b[0] + k] + t * (x[3 * b[1] + k] - x[3 * b[0] + k])) -
                 (x[3 * a[0] + k] + s * (x[3 * a[1] + k] - x[3 * a[0] + k]));
@@ -716,9 +731,20 @@ void cs_selfcol_find_pairs(cs_sim *sim, double span)
         }
     }
     finder f = {sim, sc, thickness, span};
+    for (int t = 0; t < sc->nmade; t++) /* threads added by the searches start at 0 */
+        sc->made[t].nearest = INFINITY;
     int failed = sc_cache_update(sc, sim->par->rank, thickness) ||
                  sc_find_pairs(sc, false, false, make_repulsion_point_triangle, &f, &sc->pt) ||
                  sc_find_pairs(sc, true, false, make_repulsion_edge_edge, &f, &sc->ee);
+    /* start_gap: the makers measured every pair of this rank whose boxes
+     * overlap; the others' boxes, each at least half the thickness around
+     * its particles, lie apart, so their sides are a thickness apart (less
+     * a thousandth for the boxes' round-off) */
+    double gap = 0.999 * thickness;
+    for (int t = 0; t < sc->nmade; t++)
+        if (!(sc->made[t].nearest >= gap))
+            gap = sc->made[t].nearest;
+    sc->start_gap = failed ? 0 : gap;
     sc->stats.repulsion_pairs += sc->pt.n + sc->ee.n;
     if (sc_distribute_boundary(sim, &sc->pt, &sc->ee) != 0)
         failed = 1;

@@ -40,6 +40,8 @@ typedef struct cs_selfcol_stats {
     long rewinds;              /* outer steps redone (rewind scheme) */
     long cache_searches;       /* searches of steps A and C (selfcol_cache.c) */
     long cache_builds;         /* of them, those that traversed the trees */
+    long searches_skipped;     /* step C first passes that needed no search
+                                  (every pair out of reach, start_gap) */
 } cs_selfcol_stats;
 
 /* A pair a search made, with the candidate (a, b) it came from: the key
@@ -52,6 +54,7 @@ typedef struct cs_made_pair {
 typedef struct cs_made_list {
     int n, capacity;
     cs_made_pair *m;
+    double nearest; /* the least distance the thread's makers measured */
 } cs_made_list;
 
 /* Candidate pairs kept between searches (selfcol_cache.c). */
@@ -76,6 +79,11 @@ typedef struct cs_selfcol {
     double *x_before;          /* positions when step C began */
     double *inv_mass;          /* 0 for pinned and scripted particles */
     double proximity;          /* delta: closer than this at a coplanar time collides */
+    /* Step A's lower bound on the distance in x_free between the sides of
+     * any pair this rank's step C could find (0: none known); step C's
+     * first search is skipped when no pair can close it over the span */
+    double start_gap;
+    bool use_start_gap;        /* true but in tests that compare without it */
     cs_pair_list pt, ee;       /* repulsion pairs from step A */
     cs_pair_list cpt, cee;     /* step C candidates of one pass */
     int *zone;                 /* union-find parent per particle, -1 outside zones */

@@ -194,6 +194,17 @@ static bool make_collision_edge_edge(const void *ctx, int ea, int eb, cs_pair *o
     return collision_of(cl, v, true, out);
 }
 
+/* D = the particles' mean displacement from x_free to x */
+static void mean_displacement(const cs_selfcol *sc, const double *x, double D[3])
+{
+    D[0] = D[1] = D[2] = 0;
+    for (int i = 0; i < sc->n; i++)
+        for (int d = 0; d < 3; d++)
+            D[d] += x[3 * i + d] - sc->x_free[3 * i + d];
+    for (int d = 0; d < 3; d++)
+        D[d] = sc->n ? D[d] / sc->n : 0;
+}
+
 /* Swept boxes from the free positions to x, and the pairs among their
  * primitives that collide along the trajectories, with their history (only
  * near changed particles when only_dirty). The boxes sweep in a frame
@@ -205,12 +216,8 @@ static bool make_collision_edge_edge(const void *ctx, int ea, int eb, cs_pair *o
 static long find_collisions(cs_selfcol *sc, const cs_par *par, const double *x,
                             double thickness, bool only_dirty)
 {
-    double pad = sc->proximity, D[3] = {0, 0, 0};
-    for (int i = 0; i < sc->n; i++)
-        for (int d = 0; d < 3; d++)
-            D[d] += x[3 * i + d] - sc->x_free[3 * i + d];
-    for (int d = 0; d < 3; d++)
-        D[d] = sc->n ? D[d] / sc->n : 0;
+    double pad = sc->proximity, D[3];
+    mean_displacement(sc, x, D);
 #pragma omp parallel for schedule(static)
     for (int i = 0; i < sc->n; i++) {
         cs_box *b = sc->pbox + i;
@@ -249,6 +256,42 @@ static long find_collisions(cs_selfcol *sc, const cs_par *par, const double *x,
         sc_find_pairs(sc, true, only_dirty, make_collision_edge_edge, &cl, &sc->cee))
         return -1;
     return sc->cpt.n + sc->cee.n;
+}
+
+/* True when no pair can come within the proximity tolerance over the span,
+ * so that the first search would find nothing: every pair's sides start
+ * at least start_gap apart (step A), and a pair's reach (out_of_reach) is
+ * at most twice the largest displacement of a particle relative to the
+ * cloth's mean one. A sheet in free fall, or draped and still, is settled
+ * by one pass over its particles instead of a search of its candidates.
+ * The slack is above out_of_reach's, so whenever this holds, every pair's
+ * own test would have said so. */
+static bool all_out_of_reach(cs_selfcol *sc, const double *x)
+{
+    if (!sc->use_start_gap || !(sc->start_gap > 0))
+        return false;
+    double D[3], reach2 = 0, scale = 0;
+    int not_finite = 0;
+    mean_displacement(sc, x, D);
+#pragma omp parallel for schedule(static) reduction(max : reach2, scale) reduction(|| : not_finite)
+    for (int i = 0; i < sc->n; i++) {
+        double r2 = 0;
+        for (int d = 0; d < 3; d++) {
+            double a = sc->x_free[3 * i + d], dx = x[3 * i + d] - a, r = dx - D[d];
+            r2 += r * r;
+            scale = fmax(scale, fabs(a) + fabs(dx));
+        }
+        reach2 = fmax(reach2, r2);
+        not_finite = not_finite || !isfinite(r2) || !isfinite(scale);
+    }
+    if (not_finite)
+        return false;
+    double need = sc->proximity + 2 * sqrt(reach2);
+    need += 1e-9 * need + 256 * DBL_EPSILON * (scale + need);
+    if (!(sc->start_gap > need))
+        return false;
+    sc->stats.searches_skipped++;
+    return true;
 }
 
 /* Symmetric 3x3 eigen decomposition by cyclic Jacobi rotations:
@@ -554,7 +597,10 @@ long cs_selfcol_collide(cs_sim *sim, double span, int k, bool detect_only)
                                 memcmp(x + 3 * i, sc->x_pass + 3 * i, 3 * sizeof *x) != 0;
         }
         memcpy(sc->x_pass, x, bytes);
-        long found = find_collisions(sc, par, x, d->thickness, pass > 0), found_all = found;
+        long found = pass == 0 && all_out_of_reach(sc, x)
+                         ? 0
+                         : find_collisions(sc, par, x, d->thickness, pass > 0),
+             found_all = found;
         if (found < 0)
             abort(); /* out of memory finding collisions: no collision-free state to keep */
         memset(sc->collided, 0, (size_t)n);
@@ -613,5 +659,6 @@ long cs_selfcol_collide(cs_sim *sim, double span, int k, bool detect_only)
         for (int c = 0; c < 3; c++)
             sim->v[3 * i + c] += dv[3 * i + c];
     memcpy(sc->x_free, x, bytes); /* the same on every rank */
+    sc->start_gap = 0;           /* measured in the old x_free */
     return first_pass;
 }

@@ -412,6 +412,54 @@ static void test_broad_phase_changes_nothing(void **state)
     free(text);
 }
 
+/* Step C skips its first search when step A's gap says no pair can come
+ * within reach (start_gap): the stack's sheets, falling apart and then
+ * landing on each other, must be the same bits at every frame with the
+ * skip as without it, and the comparison must mean something: searches
+ * skipped while the sheets fell, collisions found once they met. */
+static void test_start_gap_skips_only_empty_searches(void **state)
+{
+    (void)state;
+    char *text = read_scene("stack.yaml");
+    const char *o[] = {"time.frames=12"};
+    cs_scene *scene = NULL;
+    char err[512];
+    if (cs_scene_load_string(text, "stack", 1, o, &scene, err, sizeof err))
+        fail_msg("%s", err);
+    cs_sim *sim[2];
+    for (int k = 0; k < 2; k++) {
+        sim[k] = cs_sim_create(&scene->def, err, sizeof err);
+        assert_non_null(sim[k]);
+        sim[k]->selfcol->use_start_gap = k == 0;
+    }
+    int n = cs_sim_particle_count(sim[0]);
+    long collisions = 0;
+    for (int f = 1; f <= scene->frames; f++) {
+        for (int k = 0; k < 2; k++) {
+            cs_frame_stats st;
+            assert_int_equal(cs_sim_advance_frame(sim[k], &st), CS_OK);
+            if (k == 0)
+                collisions += st.collisions;
+        }
+        if (memcmp(cs_sim_positions(sim[0]), cs_sim_positions(sim[1]),
+                   sizeof(double) * 3 * (size_t)n) ||
+            memcmp(cs_sim_velocities(sim[0]), cs_sim_velocities(sim[1]),
+                   sizeof(double) * 3 * (size_t)n))
+            fail_msg("frame %d differs with step C's skip", f);
+    }
+    const cs_selfcol_stats *with = &sim[0]->selfcol->stats, *without = &sim[1]->selfcol->stats;
+    assert_true(collisions > 0);
+    assert_true(with->searches_skipped > 0);
+    assert_int_equal(without->searches_skipped, 0);
+    assert_int_equal(with->passes, without->passes);
+    print_message("start gap: %ld of %ld step C passes needed no search; %ld collisions\n",
+                  with->searches_skipped, with->passes, collisions);
+    for (int k = 0; k < 2; k++)
+        cs_sim_destroy(sim[k]);
+    cs_scene_destroy(scene);
+    free(text);
+}
+
 static void test_twisting_strip_knots_cleanly(void **state)
 {
     (void)state;
@@ -513,6 +561,7 @@ int main(void)
         cmocka_unit_test(test_stack_of_sheets),
         cmocka_unit_test(test_rewind_scheme_stack),
         cmocka_unit_test(test_broad_phase_changes_nothing),
+        cmocka_unit_test(test_start_gap_skips_only_empty_searches),
         cmocka_unit_test(test_twisting_strip_knots_cleanly),
         cmocka_unit_test(test_ends_turning_apart_wait_for_the_knot),
         cmocka_unit_test(test_ball_pushes_through_folds),
