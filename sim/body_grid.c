@@ -154,6 +154,8 @@ void cs_body_grid_build(cs_body_grid *g, const cs_body_def *bodies, int nbodies,
         return;
     if (!build_cells(g, nbounded))
         goto fail;
+    if (!x)
+        return; /* the cells only */
 
     /* candidates: count per body, prefix-sum, fill in point order */
     int *count = calloc((size_t)nbodies + 1, sizeof *count);

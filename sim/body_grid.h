@@ -29,7 +29,8 @@ typedef struct cs_body_grid {
 } cs_body_grid;
 
 /* Builds the partition for the bodies at time t and points x (3 per point);
- * only points with is_free[i] are listed. */
+ * only points with is_free[i] are listed. With x NULL, only the cells (for
+ * cs_body_grid_cell_bodies): no point is listed. */
 void cs_body_grid_build(cs_body_grid *g, const cs_body_def *bodies, int nbodies, double t,
                         const double *x, const unsigned char *is_free, int n);
 void cs_body_grid_free(cs_body_grid *g);
