@@ -28,9 +28,9 @@
  * lives longer but holds more pairs to filter (measured on the 100 x 100
  * benchmark sheet; see README, "Speed at resolution"). */
 static const double CACHE_SLACK_PER_THICKNESS = 0.5;
-/* A particle moving relative to the cloth, whose box is wider than half the
- * thickness by m (its motion over the span), gets m more slack: it will
- * have moved about as far by the next search. With the fixed slack alone
+/* A particle moving relative to the cloth, whose search box reaches m past
+ * half the thickness around it (its motion over the span), gets m more
+ * slack: it will have moved about as far by the next search. With the fixed slack alone
  * the falling rim of a sheet landing on a ball escaped at every outer step
  * (15-35% of the particles at 100 x 100, frame 11), so every search
  * rebuilt. A particle moving more than this many thicknesses a span gets
@@ -82,7 +82,12 @@ static int rebuild(cs_selfcol *sc, int rank, double thickness, const double anch
         cs_box_thicken(&around, 0.5 * thickness);
         cs_box_add_point(b, around.lo);
         cs_box_add_point(b, around.hi);
-        double moving = 0.5 * (sc->pbox[i].hi[0] - sc->pbox[i].lo[0]) - 0.5 * thickness;
+        /* how far the search's box reaches past half the thickness around
+         * x_free: step A's margin for motion, step C's sweep */
+        double moving = 0;
+        for (int d = 0; d < 3; d++)
+            moving = fmax(moving, fmax(sc->pbox[i].hi[d] - around.hi[d],
+                                       around.lo[d] - sc->pbox[i].lo[d]));
         bool steady = moving > 0 && moving <= CACHE_MOTION_SLACK_MAX * thickness;
         cs_box_thicken(b, slack + (steady ? moving : 0));
     }
