@@ -267,19 +267,20 @@ int cs_cg_solve(cs_sim *sim, double *v0, const double *rhs, double *v, double *w
      * frame's samples (the first iteration applies A to p, which the
      * setup pass made). */
     int it = 0;
-    double beta = 0;
+    double beta = 0, pending = 0; /* pending: the last alpha, not yet in z */
     while (it < sim->def.cg_max_iterations && residual > sim->def.cg_tolerance) {
         double *operand = it == 0 ? w->p : w->y;
         cs_halo_forward(par, &par->ghosts, operand, 3);
-        FOR_BLOCKS(sim, b, r0, r1) { /* p = y + beta p, q = P A p, p . q */
+        FOR_BLOCKS(sim, b, r0, r1) { /* z += alpha p, p = y + beta p, q = P A p, p . q */
             double sum = 0;
             for (int r = r0; r < r1; r++) {
                 int i = own[r];
-                double *qi = w->q + 3 * i, *pi = w->p + 3 * i, a[3];
+                double *qi = w->q + 3 * i, *pi = w->p + 3 * i, *zi = w->z + 3 * i, a[3];
                 system_row(sim, r, i, operand, a);
                 project_row(sim, i, a);
                 for (int d = 0; d < 3; d++) {
                     if (it > 0) {
+                        zi[d] += pending * pi[d];
                         pi[d] = w->y[3 * i + d] + beta * pi[d];
                         qi[d] = a[d] + beta * qi[d];
                     } else {
@@ -290,20 +291,22 @@ int cs_cg_solve(cs_sim *sim, double *v0, const double *rhs, double *v, double *w
             }
             part_sum[b] = sum;
         }
+        pending = 0; /* the pass above took it into z */
         double pq = reduce(sim, part_sum, NULL, NULL);
         if (!(pq > 0))
             break; /* not positive definite along p: nothing more to gain */
         double alpha = rho / pq;
+        /* z += alpha p waits for the next pass over p (the operator's, or
+         * the last one below): this pass then reads neither p nor z, a
+         * sixth of its bytes, and z gets the same sums in the same order */
+        pending = alpha;
         FOR_BLOCKS(sim, b, r0, r1) {
             double sum = 0, worst = 0;
             for (int r = r0; r < r1; r++) {
                 int i = own[r];
                 double *yi = w->y + 3 * i, *ri = w->r + 3 * i;
-                for (int d = 0; d < 3; d++) {
-                    int k = 3 * i + d;
-                    w->z[k] += alpha * w->p[k];
-                    w->r[k] -= alpha * w->q[k];
-                }
+                for (int d = 0; d < 3; d++)
+                    ri[d] -= alpha * w->q[3 * i + d];
                 precondition_row(sim, i, ri, yi, &sum, &worst);
             }
             part_sum[b] = sum;
@@ -318,10 +321,11 @@ int cs_cg_solve(cs_sim *sim, double *v0, const double *rhs, double *v, double *w
     for (int r = 0; r < par->nowned; r++)
         for (int d = 0; d < 3; d++) {
             int k = 3 * own[r] + d;
-            v[k] = v0[k] + w->z[k];
+            double z = pending != 0 ? w->z[k] + pending * w->p[k] : w->z[k];
+            v[k] = v0[k] + z;
             if (warm) {
                 warm_before[k] = warm[k];
-                warm[k] = w->z[k] - w->explicit_z[k];
+                warm[k] = z - w->explicit_z[k];
             }
         }
     return it;
