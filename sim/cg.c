@@ -192,7 +192,7 @@ static const double WARM_BEFORE_WEIGHT = 0.75;
  * ghosts). The stopping test is the residual in velocity units, max over
  * particles of |r_i| / m_i: a maximum is exact, so every rank and thread
  * count stops at the same iteration. */
-int cs_cg_solve(cs_sim *sim, double *v0, const double *rhs, double *v, double *warm,
+int cs_cg_solve(cs_sim *sim, const double *v0, const double *rhs, double *v, double *warm,
                 double *warm_before)
 {
     cs_par *par = sim->par;

@@ -49,7 +49,7 @@ typedef struct cs_cloth_state {
 enum { CS_BLOCK = 64 };
 
 typedef struct cs_cg_work {
-    double *z, *r, *y, *p, *q, *b;
+    double *z, *r, *y, *p, *q;
     double *explicit_z;          /* the explicit update CG starts from */
     double *block;               /* 6 per particle: the preconditioner's 3 x 3 inverse */
     /* the damping responses of B.1's and B.5's last solves, and of the
@@ -129,7 +129,7 @@ int cs_sort_unique_pairs(int *pairs, int n);
  * damping responses of the last two solves of the same kind, whose blend
  * is added to the start; they shift by one, warm receiving this one's.
  * Returns the iteration count, the same on every rank. */
-int cs_cg_solve(cs_sim *sim, double *v0, const double *rhs, double *v, double *warm,
+int cs_cg_solve(cs_sim *sim, const double *v0, const double *rhs, double *v, double *warm,
                 double *warm_before);
 /* out = (M - (dt/2) D) v, D the damping (and wind drag) velocity Jacobian. */
 void cs_system_apply(const cs_sim *sim, const double *v, double *out);

@@ -237,7 +237,7 @@ int cs_sim_create_checked(const cs_sim_def *def, cs_sim **out, char *err, size_t
     if (ok && !def->plan_only) { /* the step's scratch */
         double **scratch[] = {&sim->x_prev, &sim->v_half, &sim->v_star, &sim->v_next,
                               &sim->force, &sim->v0, &sim->rhs, &sim->cg.z, &sim->cg.r,
-                              &sim->cg.y, &sim->cg.p, &sim->cg.q, &sim->cg.b,
+                              &sim->cg.y, &sim->cg.p, &sim->cg.q,
                               &sim->cg.explicit_z, &sim->cg.warm_half, &sim->cg.warm_full,
                               &sim->cg.warm_half_before, &sim->cg.warm_full_before};
         for (size_t k = 0; k < sizeof scratch / sizeof *scratch && ok; k++)
@@ -458,7 +458,7 @@ void cs_sim_destroy(cs_sim *sim)
                         sim->v_next, sim->force, sim->v0, sim->rhs, sim->script_x,
                         sim->script_v, sim->contact_normal, sim->wind_normal, sim->wind_area, sim->v_rewind,
                         sim->cg.z, sim->cg.r, sim->cg.y, sim->cg.p, sim->cg.q,
-                        sim->cg.b, sim->cg.partial, sim->cg.explicit_z, sim->cg.warm_half,
+                        sim->cg.partial, sim->cg.explicit_z, sim->cg.warm_half,
                         sim->cg.warm_full, sim->cg.warm_half_before, sim->cg.warm_full_before,
                         sim->cg.block, sim->cg.inv_mass};
     for (size_t k = 0; k < sizeof arrays / sizeof *arrays; k++)

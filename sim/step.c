@@ -283,8 +283,7 @@ static const double *stage_velocity_full(cs_sim *sim, const step_state *st)
             sim->v_half[3 * i + d] = 0.5 * (sim->x_prev[3 * i + d] + sim->x[3 * i + d]);
     explicit_forces(sim, sim->v_half, sim->v_star, st->t1 - 0.5 * st->dt); /* at x^(n+1/2) */
     double *v_p = sim->v0; /* v0 is free again */
-    copy_ranges(par->own, par->nown, sim->cg.b, sim->v_star);
-    sim->cg_iterations += cs_cg_solve(sim, sim->cg.b, sim->rhs, v_p, sim->cg.warm_full,
+    sim->cg_iterations += cs_cg_solve(sim, sim->v_star, sim->rhs, v_p, sim->cg.warm_full,
                                       sim->cg.warm_full_before);
     if (st->bodies && sim->def.friction_method == CS_FRICTION_IMPROVED) {
         copy_ranges(par->local, par->nlocal, sim->v_next, sim->force);
