@@ -76,6 +76,34 @@ def triad(build):
     return float(out[1])
 
 
+def machine():
+    """The CPU model, its count and caches (lscpu), for the README's "with the machine"."""
+    model = "unknown CPU"
+    try:
+        with open("/proc/cpuinfo") as f:
+            model = next((l.split(":", 1)[1].strip() for l in f if l.startswith("model name")), model)
+    except OSError:
+        pass
+    caches = []
+    try:
+        out = subprocess.run(["lscpu"], capture_output=True, text=True, check=False).stdout
+        caches = [l.split(":", 1)[0].strip() + " " + l.split(":", 1)[1].strip()
+                  for l in out.splitlines() if l.startswith(("L2 cache", "L3 cache"))]
+    except OSError:
+        pass
+    return ", ".join([model, "%d CPUs" % os.cpu_count()] + caches)
+
+
+def cpu_times():
+    """(steal, total) jiffies of all CPUs from /proc/stat, or None"""
+    try:
+        with open("/proc/stat") as f:
+            v = [int(x) for x in f.readline().split()[1:]]
+        return v[7] if len(v) > 7 else 0, sum(v[:8])
+    except (OSError, ValueError):
+        return None
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--build", default=os.path.join(ROOT, "build"))
@@ -96,6 +124,7 @@ def main():
     modes = [m == "on" for m in a.modes.split(",")]
     os.makedirs(a.out, exist_ok=True)
     bw = triad(a.build)
+    start_times = cpu_times()
     rows, tables = [], []
     for selfcol in modes:
         for n in sizes:
@@ -136,17 +165,17 @@ def main():
                 "ns_per_spring_step": 1e9 * inner / max(steps * springs, 1),
             }
             # traffic model of one step, if every byte came from memory
-            # (sim/springs.c, sim/cg.c as of 2026-12-02): every spring is an
+            # (sim/springs.c, sim/cg.c as of 2026-12-03): every spring is an
             # entry in both its ends' rows. The prepare pass (twice a step)
             # reads an entry's far end (4 B) and 3 constants (24 B) and
             # writes its direction (24 B) and magnitude (8 B): 120 B per
             # spring. A damping pass reads far end and direction: 56 B per
             # spring; a step makes 2 CG setup passes, 1 for v_NP and one
-            # per CG iteration. CG's vectors: about 14 arrays of 24 B per
-            # particle per iteration, and 30 per step for the rest.
+            # per CG iteration. CG's vectors: about 13 arrays of 24 B per
+            # particle per iteration, and 28 per step for the rest.
             it_step = cg / max(steps, 1)
             bytes_step = springs * (2 * 120 + 56 * (3 + it_step)) + \
-                s["particles"] * 24 * (30 + 14 * it_step)
+                s["particles"] * 24 * (28 + 13 * it_step)
             row["model_GBps"] = bytes_step * steps / inner / 1e9 if inner > 0 else 0
             row["triad_GBps"] = bw or 0
             rows.append(row)
@@ -157,7 +186,15 @@ def main():
         f.write(",".join(fields) + "\n")
         for r in rows:
             f.write(",".join(("%.6g" % v) if isinstance(v, float) else str(v) for v in r.values()) + "\n")
-    md = ["| quads | triangles | self-collision | threads | s/frame (median of %d; min-max) | steps/frame | CG it./frame | peak MiB | max intersecting pairs (frames) | ns/spring/step |" % a.repeat,
+    end_times = cpu_times()
+    # a VM's steal time (its host running others on our CPUs) makes whole
+    # runs of one binary differ by up to 2x: say how much there was
+    steal = ""
+    if start_times and end_times and end_times[1] > start_times[1]:
+        steal = "; steal time during the runs %.1f%%" % (
+            100.0 * (end_times[0] - start_times[0]) / (end_times[1] - start_times[1]))
+    md = ["machine: %s%s\n" % (machine(), steal),
+          "| quads | triangles | self-collision | threads | s/frame (median of %d; min-max) | steps/frame | CG it./frame | peak MiB | max intersecting pairs (frames) | ns/spring/step |" % a.repeat,
           "|---|---|---|---|---|---|---|---|---|---|"]
     for r in rows:
         md.append("| %d | %d | %s | %d | %.3f (%.3f-%.3f) | %.0f | %.0f | %.0f | %s (%d) | %.2f |" % (
