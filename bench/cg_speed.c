@@ -15,20 +15,13 @@
  * Threads: OMP_NUM_THREADS (default one per core). Prints one line. */
 #include <math.h>
 #include <omp.h>
-#include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <time.h>
+#include <xxhash.h>
 
+#include "common/util.h"
 #include "sim/internal.h"
-
-static double now(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
 
 /* a fixed pseudo-random sequence in [-0.5, 0.5] */
 static double jitter(unsigned *seed)
@@ -37,14 +30,10 @@ static double jitter(unsigned *seed)
     return ((*seed >> 8) & 0xffff) / 65535.0 - 0.5;
 }
 
-/* FNV-1a over the bytes of n doubles */
-static uint64_t hash(const double *a, int n)
+/* XXH3 over the bytes of n doubles, as the frames' state hashes */
+static unsigned long long hash(const double *a, int n)
 {
-    uint64_t h = 1469598103934665603u;
-    const unsigned char *p = (const unsigned char *)a;
-    for (size_t k = 0; k < sizeof *a * (size_t)n; k++)
-        h = (h ^ p[k]) * 1099511628211u;
-    return h;
+    return (unsigned long long)XXH3_64bits(a, sizeof *a * (size_t)n);
 }
 
 int main(int argc, char **argv)
@@ -97,20 +86,20 @@ int main(int argc, char **argv)
     double apply = INFINITY, solve = INFINITY;
     int iterations = 0;
     for (int rep = 0; rep < 5; rep++) {
-        double t0 = now();
+        double t0 = cs_now();
         for (int c = 0; c < calls; c++)
             cs_system_apply(sim, v, out);
-        apply = fmin(apply, (now() - t0) / calls);
-        t0 = now();
+        apply = fmin(apply, (cs_now() - t0) / calls);
+        t0 = cs_now();
         iterations = cs_cg_solve(sim, v0, rhs, sol, NULL, NULL);
-        solve = fmin(solve, now() - t0);
+        solve = fmin(solve, cs_now() - t0);
     }
     long entries = sim->springs.row_start[sim->springs.nrows];
     printf("quads %d particles %d row_entries %ld threads %d half_dt %g: operator %.1f us "
            "(%.2f ns per entry), solve %d iterations %.1f us each, hashes %016llx %016llx\n",
            n, sim->n, entries, omp_get_max_threads(), half_dt, 1e6 * apply,
            1e9 * apply / (double)entries, iterations, 1e6 * solve / (iterations ? iterations : 1),
-           (unsigned long long)hash(out, n3), (unsigned long long)hash(sol, n3));
+           hash(out, n3), hash(sol, n3));
     free(v);
     free(out);
     free(v0);

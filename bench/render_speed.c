@@ -13,17 +13,11 @@
 #include <time.h>
 #include <unistd.h>
 
+#include "common/util.h"
 #include "render/render.h"
 #include "sim/sim.h"
 
 #define RUNS 3
-
-static double now_seconds(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
 
 /* CPU seconds of the whole process (all threads): on a machine shared with
  * other work, CPU time / cores estimates the wall time of an idle one. */
@@ -155,17 +149,17 @@ int main(int argc, char **argv)
         cs_render_settings p = s;
         p.engine = CS_RENDER_PREVIEW;
         p.samples = msaa ? 4 : 1;
-        double t0 = now_seconds();
+        double t0 = cs_now();
         r = cs_renderer_create(&p, err, sizeof err);
         if (!r) {
             fprintf(stderr, "bench_render_speed: %s\n", err);
             return 1;
         }
         printf("preview (%d sample%s): context and shaders %.3f s\n", p.samples,
-               p.samples > 1 ? "s" : "", now_seconds() - t0);
+               p.samples > 1 ? "s" : "", cs_now() - t0);
         int frames = 10;
         for (int k = 0; k < RUNS; k++) {
-            t0 = now_seconds();
+            t0 = cs_now();
             double c0 = cpu_seconds();
             for (int f = 0; f < frames; f++)
                 if (cs_renderer_draw(r, 3, meshes, &cam, img, NULL, err, sizeof err) !=
@@ -173,7 +167,7 @@ int main(int argc, char **argv)
                     fprintf(stderr, "bench_render_speed: %s\n", err);
                     return 1;
                 }
-            fps[msaa][k] = frames / (now_seconds() - t0);
+            fps[msaa][k] = frames / (cs_now() - t0);
             fps_cpu[msaa][k] = frames / (cpu_seconds() - c0);
             printf("preview run %d: %.2f frames/s (%.2f per CPU second)\n", k + 1, fps[msaa][k],
                    fps_cpu[msaa][k]);

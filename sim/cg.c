@@ -297,8 +297,8 @@ int cs_cg_solve(cs_sim *sim, const double *v0, const double *rhs, double *v, dou
             break; /* not positive definite along p: nothing more to gain */
         double alpha = rho / pq;
         /* z += alpha p waits for the next pass over p (the operator's, or
-         * the last one below): this pass then reads neither p nor z, a
-         * sixth of its bytes, and z gets the same sums in the same order */
+         * the last one below): this pass then reads neither p nor z, and z
+         * gets the same sums in the same order */
         pending = alpha;
         FOR_BLOCKS(sim, b, r0, r1) {
             double sum = 0, worst = 0;
