@@ -30,7 +30,7 @@ static double jitter(unsigned *seed)
     return ((*seed >> 8) & 0xffff) / 65535.0 - 0.5;
 }
 
-/* XXH3 over the bytes of n doubles, as the frames' state hashes */
+/* XXH3 (64-bit) over the bytes of n doubles: equal hashes, the same bits */
 static unsigned long long hash(const double *a, int n)
 {
     return (unsigned long long)XXH3_64bits(a, sizeof *a * (size_t)n);

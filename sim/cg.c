@@ -321,6 +321,8 @@ int cs_cg_solve(cs_sim *sim, const double *v0, const double *rhs, double *v, dou
     for (int r = 0; r < par->nowned; r++)
         for (int d = 0; d < 3; d++) {
             int k = 3 * own[r] + d;
+            /* only a pending step is added: z + 0 p would turn a -0 into
+             * +0 (or a non-finite p into NaN) and change the bits */
             double z = pending != 0 ? w->z[k] + pending * w->p[k] : w->z[k];
             v[k] = v0[k] + z;
             if (warm) {
