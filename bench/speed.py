@@ -15,7 +15,8 @@ for the largest case the inner step's cost in ns per spring per step and as
 estimated memory traffic against a STREAM triad measured in the same run.
 
 usage: bench/speed.py [--build DIR] [--repeat N] [--frames N] [--sizes 50,100,200]
-                      [--modes on,off] [--step-limit undamped|damped] [--out DIR]
+                      [--modes on,off] [--step-limit undamped|damped]
+                      [--pruning speed|path] [--out DIR]
 Writes DIR/speed.csv and DIR/speed.md (default out/speed). Numbers go in the
 README by hand, with the machine. A Release build is expected.
 """
@@ -40,13 +41,14 @@ def die(msg):
     sys.exit("speed.py: " + msg)
 
 
-def run_once(exe, n, selfcol, frames, out, step_limit):
+def run_once(exe, n, selfcol, frames, out, step_limit, pruning):
     """One whole run; returns (wall seconds, peak RSS MiB, summary, stage table text)."""
     thick = THICKNESS.get(n, 0.4 / n)
     args = [exe, "run", SCENE, "-o", out, "-q", "--frames", str(frames),
             "--set", "cloths.0.grid.resolution=[%d,%d]" % (n, n),
             "--set", "self_collision.thickness=%g" % thick,
-            "--set", "time.step_limit=" + step_limit]
+            "--set", "time.step_limit=" + step_limit,
+            "--set", "self_collision.pruning=" + pruning]
     if not selfcol:
         args += ["--set", "effects.self_collision=false"]
     os.makedirs(out, exist_ok=True)
@@ -113,6 +115,8 @@ def main():
     ap.add_argument("--modes", default="on,off")
     ap.add_argument("--step-limit", default="undamped", choices=["undamped", "damped"],
                     help="time.step_limit for every run (the scene's default is undamped)")
+    ap.add_argument("--pruning", default="speed", choices=["speed", "path"],
+                    help="self_collision.pruning for every run (the scene's default is speed)")
     ap.add_argument("--out", default=os.path.join(ROOT, "out", "speed"))
     a = ap.parse_args()
     exe = os.path.join(a.build, "clothsim")
@@ -132,7 +136,7 @@ def main():
             for rep in range(a.repeat):
                 runs.append(run_once(exe, n, selfcol, a.frames,
                                      os.path.join(a.out, "run_%d_%s" % (n, "on" if selfcol else "off")),
-                                     a.step_limit))
+                                     a.step_limit, a.pruning))
                 print("  %dx%d self-collision %s, run %d: %.3f s/frame" %
                       (n, n, "on" if selfcol else "off", rep + 1, runs[-1][0] / a.frames),
                       file=sys.stderr, flush=True)

@@ -44,6 +44,10 @@ static const cyaml_strval_t scheme_names[] = {
     {"fixed", CS_COLLISION_FIXED},
     {"rewind", CS_COLLISION_REWIND},
 };
+static const cyaml_strval_t pruning_names[] = {
+    {"speed", CS_PRUNING_SPEED},
+    {"path", CS_PRUNING_PATH},
+};
 static const cyaml_strval_t format_names[] = {{"ply", 0}, {"obj", 1}, {"glb", 2}};
 static const cyaml_strval_t shape_names[] = {
     {"plane", CS_BODY_PLANE},       {"sphere", CS_BODY_SPHERE}, {"box", CS_BODY_BOX},

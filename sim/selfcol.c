@@ -688,26 +688,38 @@ void cs_selfcol_find_pairs(cs_sim *sim, double span)
     cs_par_allgather(sim->par, sim->v, 3); /* velocities widen the boxes */
     double thickness = sim->def.self.thickness;
     sc->pt.n = sc->ee.n = 0;
-    /* non-aggressive pruning: boxes grow by half the thickness plus the distance each
+    /* The particles' boxes (def.self.pruning). `speed`, the paper's
+     * non-aggressive pruning: half the thickness plus the distance the
      * particle would cover in the span at its present velocity relative to
-     * the cloth's mean velocity (a pair's relative speed is at most the sum
-     * of its particles' speeds relative to any common velocity, and only
-     * relative motion brings a pair closer: a sheet falling rigidly needs
-     * no wider boxes than one at rest). A pair that comes closer faster
-     * than that is step C's to catch. */
+     * the cloth's mean velocity, along all three axes (a pair's relative
+     * speed is at most the sum of its particles' speeds relative to any
+     * common velocity, so every pair may_meet keeps is found). `path`: the
+     * particle's straight path relative to the mean, x + (v - mean) s for s
+     * in [0, span], grown by half the thickness; if a pair's straight
+     * relative path comes within the thickness at some s, the points x_a +
+     * (v_a - mean) s and x_b + (v_b - mean) s are within it, so the boxes
+     * overlap. Either way only relative motion widens a box: a sheet
+     * falling rigidly needs no wider boxes than one at rest. A pair that
+     * comes closer faster than that is step C's to catch. */
     double mean[3] = {0, 0, 0};
     for (int i = 0; i < sc->n; i++)
         cs_axpy(1.0 / sc->n, sim->v + 3 * i, mean);
-    double *margin = sim->force; /* scratch, free between steps */
+    bool path = sim->def.self.pruning == CS_PRUNING_PATH;
     /* the boxes: one writer each, so threads change no bit */
 #pragma omp parallel for schedule(static)
     for (int i = 0; i < sc->n; i++) {
-        double rel[3];
+        double rel[3], end[3];
         cs_sub(sim->v + 3 * i, mean, rel);
-        margin[i] = 0.5 * thickness + cs_norm(rel) * span;
         cs_box_empty(sc->pbox + i);
         cs_box_add_point(sc->pbox + i, x + 3 * i);
-        cs_box_thicken(sc->pbox + i, margin[i]);
+        if (path) {
+            for (int d = 0; d < 3; d++)
+                end[d] = x[3 * i + d] + rel[d] * span;
+            cs_box_add_point(sc->pbox + i, end);
+            cs_box_thicken(sc->pbox + i, 0.5 * thickness);
+        } else {
+            cs_box_thicken(sc->pbox + i, 0.5 * thickness + cs_norm(rel) * span);
+        }
     }
 #pragma omp parallel for schedule(static)
     for (int k = 0; k < sc->ne; k++) {

@@ -33,6 +33,7 @@ cs_self_collision_def cs_default_self_collision_def(void)
         .edge_flip_epsilon = 0.5,
         .zone_iterations = 8,
         .scheme = CS_COLLISION_FIXED,
+        .pruning = CS_PRUNING_SPEED,
         .verify = false,
     };
     return d;
@@ -92,6 +93,8 @@ static int validate(const cs_sim_def *def, char *err, size_t errlen)
     if (def->self_collision &&
         !(def->self.edge_flip_epsilon >= -1 && def->self.edge_flip_epsilon <= 1))
         return fail(err, errlen, "self-collision needs edge_flip_epsilon in [-1, 1]");
+    if (def->self.pruning != CS_PRUNING_SPEED && def->self.pruning != CS_PRUNING_PATH)
+        return fail(err, errlen, "self-collision pruning must be speed or path");
     if (!(def->fps > 0))
         return fail(err, errlen, "fps must be > 0");
     if (!(def->dt >= 0) || !(def->dt_safety > 0 && def->dt_safety <= 1))

@@ -277,6 +277,16 @@ typedef enum cs_collision_scheme {
                                  rewind and retry with k_i halved, down to 1 */
 } cs_collision_scheme;
 
+/* Step A's broad phase (README, "Speed at resolution"). */
+typedef enum cs_pair_pruning {
+    CS_PRUNING_SPEED = 0, /* the paper's non-aggressive pruning: a particle's
+                             box grows by its speed relative to the cloth's
+                             mean times the span, along all three axes */
+    CS_PRUNING_PATH,      /* the box holds the particle's straight path
+                             relative to the mean over the span: only pairs
+                             whose straight paths come within h are kept */
+} cs_pair_pruning;
+
 typedef struct cs_self_collision_def {
     double thickness;          /* h, repulsion thickness, m          (0.01) */
     double stiffness;          /* k of Eq. 1, repulsion spring constant (30) */
@@ -286,6 +296,7 @@ typedef struct cs_self_collision_def {
                                   conservative)                         (0.5) */
     int zone_iterations;       /* step C passes before impact zones      (8) */
     cs_collision_scheme scheme;
+    cs_pair_pruning pruning;   /* step A's broad phase              (speed) */
     bool verify;               /* count intersecting triangle pairs at each
                                   frame end (an independent check)  (false) */
 } cs_self_collision_def;

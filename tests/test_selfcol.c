@@ -415,6 +415,70 @@ static void test_broad_phase_changes_nothing(void **state)
     free(text);
 }
 
+/* Step A's pairs of frame 1 (one outer step): a small free triangle 3 mm
+ * over the pinned floor triangle, thickness 1 mm, moving at 1 m/s for a
+ * 4 ms span, sideways or down, with self_collision.pruning set. */
+static long first_step_pairs(const char *pruning, const char *velocity)
+{
+    char text[1024], option[64];
+    snprintf(text, sizeof text,
+             "time: {fps: 250, frames: 1, dt: 1e-3, collision_steps: 4}\n"
+             "gravity: [0, 0, 0]\n"
+             "effects: {self_collision: true}\n"
+             "self_collision: {thickness: 0.001}\n"
+             "cloths:\n" FLOOR_TRIANGLE
+             "  - name: dart\n"
+             "    mesh: {vertices: [[0, 0.003, 0], [0.1, 0.003, 0], [0, 0.003, 0.1]],\n"
+             "           triangles: [[0, 1, 2]]}\n"
+             "    velocity: %s\n",
+             velocity);
+    snprintf(option, sizeof option, "self_collision.pruning=%s", pruning);
+    const char *o[] = {option};
+    cs_scene *scene = NULL;
+    char err[512];
+    if (cs_scene_load_string(text, "pruning", 1, o, &scene, err, sizeof err))
+        fail_msg("%s", err);
+    cs_sim *sim = cs_sim_create(&scene->def, err, sizeof err);
+    if (!sim)
+        fail_msg("%s", err);
+    cs_frame_stats st;
+    assert_int_equal(cs_sim_advance_frame(sim, &st), CS_OK);
+    assert_int_equal(cs_sim_count_intersections(sim), 0);
+    cs_sim_destroy(sim);
+    cs_scene_destroy(scene);
+    return st.repulsion_pairs;
+}
+
+/* The two broad phases of step A. Moving sideways, the triangle's corners
+ * stay 3 mm over the floor: `speed` keeps them as pairs (3 mm is within
+ * the thickness plus 1 m/s times the span) and `path` does not (their
+ * straight paths never come within the thickness). Moving down they reach
+ * the floor within the span, and both keep the same pairs. */
+static void test_path_pruning_keeps_only_approaching_pairs(void **state)
+{
+    (void)state;
+    long speed_side = first_step_pairs("speed", "[1, 0, 0]");
+    long path_side = first_step_pairs("path", "[1, 0, 0]");
+    long speed_down = first_step_pairs("speed", "[0, -1, 0]");
+    long path_down = first_step_pairs("path", "[0, -1, 0]");
+    print_message("pairs: sideways %ld (speed) %ld (path), down %ld %ld\n", speed_side,
+                  path_side, speed_down, path_down);
+    assert_int_equal(speed_side, 3);
+    assert_int_equal(path_side, 0);
+    assert_int_equal(speed_down, 3);
+    assert_int_equal(path_down, 3);
+}
+
+/* Path pruning on tangled cloth keeps the invariant too. */
+static void test_path_pruning_stack(void **state)
+{
+    (void)state;
+    char *text = read_scene("stack.yaml");
+    const char *o[] = {"self_collision.pruning=path"};
+    run_scene("stack of sheets, path pruning", text, 1, o, 20);
+    free(text);
+}
+
 /* Step C skips its first search when step A's gap says no pair can come
  * within reach (start_gap): the stack's sheets, falling apart and then
  * landing on each other, must be the same bits at every frame with the
@@ -573,6 +637,8 @@ int main(int argc, char **argv)
         cmocka_unit_test(test_stack_of_sheets),
         cmocka_unit_test(test_rewind_scheme_stack),
         cmocka_unit_test(test_broad_phase_changes_nothing),
+        cmocka_unit_test(test_path_pruning_keeps_only_approaching_pairs),
+        cmocka_unit_test(test_path_pruning_stack),
         cmocka_unit_test(test_start_gap_skips_only_empty_searches),
         cmocka_unit_test(test_twist_strip_knots_cleanly),
         cmocka_unit_test(test_twist_ends_turning_apart_wait_for_the_knot),
