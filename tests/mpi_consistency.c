@@ -314,6 +314,11 @@ int main(int argc, char **argv)
      * pass: the zones must still span ranks */
     const char *stack[] = {"time.frames=8", "self_collision.zone_iterations=1"};
     test_collision_free_with_self_collision("stack.yaml", 8, 2, stack, CENTRE_BOUND, true);
+    /* step A's other broad phase: its boxes come from every particle's
+     * velocity, gathered to every rank, so ranks find the same pairs */
+    const char *stack_path[] = {"time.frames=8", "self_collision.zone_iterations=1",
+                                "self_collision.pruning=path"};
+    test_collision_free_with_self_collision("stack.yaml", 8, 3, stack_path, CENTRE_BOUND, true);
     /* the strip knots onto itself; repulsions too thin to stop it, so step
      * C's collisions and impact zones (early: after one pass, as for the
      * stack; whether a second pass settles the knot's collisions turns on
