@@ -698,7 +698,11 @@ void cs_selfcol_find_pairs(cs_sim *sim, double span)
      * in [0, span], grown by half the thickness; if a pair's straight
      * relative path comes within the thickness at some s, the points x_a +
      * (v_a - mean) s and x_b + (v_b - mean) s are within it, so the boxes
-     * overlap. Either way only relative motion widens a box: a sheet
+     * overlap. A pair must pass both the boxes and may_meet, so `path`
+     * drops the pairs within may_meet's reach whose straight paths miss:
+     * another rule, not only a faster search (the same frames on drapes,
+     * not on cloth folding onto itself; README, "Speed at resolution").
+     * Either way only relative motion widens a box: a sheet
      * falling rigidly needs no wider boxes than one at rest. A pair that
      * comes closer faster than that is step C's to catch. */
     double mean[3] = {0, 0, 0};
