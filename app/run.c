@@ -369,6 +369,9 @@ static void print_plan(const cs_scene *scene, const cs_sim *sim, FILE *out)
     if (!(scene->def.dt > 0) && scene->def.step_limit == CS_STEP_DAMPED)
         fprintf(out, "  time.step_limit damped: the step is chosen again before every outer "
                 "step, smaller where the cloth is stretched\n");
+    if (scene->def.self_collision && scene->def.self.pruning == CS_PRUNING_PATH)
+        fprintf(out, "  self_collision.pruning path: step A keeps only the pairs whose straight "
+                "relative paths come within the thickness\n");
     fprintf(out, "%d frames after the initial one: %.6g s of simulated time; %d particles\n",
             scene->frames, scene->def.fps > 0 ? scene->frames / scene->def.fps : 0.0,
             cs_sim_particle_count(sim));

@@ -125,6 +125,9 @@ plan = json.load(open("out/tiny/summary.json"))["plan"]
 out = open("out.txt").read()
 sys.exit(0 if all(p in out for p in plan) else "plan output lacks stages")
 ' || fail "--plan does not name the planned stages"
+! grep -q 'pruning' out.txt || fail "--plan names a pruning the scene did not ask for"
+run 0 run tiny.yaml --plan --set effects.self_collision=true --set self_collision.pruning=path
+grep -q 'self_collision.pruning path' out.txt || fail "--plan does not say step A prunes by path"
 
 # --- overrides: --set time.frames=1, --frames 2; a rerun replaces old frames
 run 0 run tiny.yaml -q -o one --set time.frames=1
