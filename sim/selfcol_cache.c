@@ -26,7 +26,7 @@
 
 /* The slack a rebuild grows each particle's box by, per thickness: wider
  * lives longer but holds more pairs to filter (measured on the 100 x 100
- * benchmark sheet; see README, "Speed at resolution"). */
+ * benchmark sheet; docs/performance-log.md, "Candidate pairs kept"). */
 static const double CACHE_SLACK_PER_THICKNESS = 0.5;
 /* A particle moving relative to the cloth, whose search box reaches m past
  * half the thickness around it (its motion over the span), gets m more
