@@ -17,6 +17,7 @@
 #include <unistd.h>
 
 #include "import/import.h"
+#include "tests/scene_load.h"
 
 #ifndef CS_ASSETS_DIR
 #error "CS_ASSETS_DIR must name the repository's assets/ folder (tests/CMakeLists.txt defines it)"
@@ -46,30 +47,6 @@ static int teardown(void **state)
     char cmd[300];
     snprintf(cmd, sizeof cmd, "rm -rf '%s'", tmpdir);
     return system(cmd) == 0 ? 0 : -1;
-}
-
-static cs_scene *load_ok(const char *text, int nov, const char *const *ov)
-{
-    char err[1024] = "";
-    cs_scene *s = NULL;
-    int rc = cs_scene_load_string(text, "scenes/a.yaml", nov, ov, &s, err, sizeof err);
-    if (rc != CS_IMPORT_OK)
-        print_error("unexpected error: %s\n", err);
-    assert_int_equal(rc, CS_IMPORT_OK);
-    return s;
-}
-
-static void expect_error(const char *text, int nov, const char *const *ov, const char *want)
-{
-    char err[1024] = "";
-    cs_scene *s = (cs_scene *)&err;
-    int rc = cs_scene_load_string(text, "scenes/a.yaml", nov, ov, &s, err, sizeof err);
-    if (rc != CS_IMPORT_BAD_INPUT || strcmp(err, want) != 0)
-        print_error("got:  %s\nwant: %s\n", err, want);
-    assert_int_equal(rc, CS_IMPORT_BAD_INPUT);
-    assert_null(s);
-    assert_null(strchr(err, '\n'));
-    assert_string_equal(err, want);
 }
 
 /* The error starts with want (for messages that go on with a path or a
