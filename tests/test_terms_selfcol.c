@@ -6,7 +6,7 @@
  * second cloth is pinned (its inverse mass is 0), so a pair's response
  * moves the free side alone and the expected motion is exact. Time steps
  * are set explicitly (Eq. 1 depends on dt). The other terms are in
- * test_terms.c, with the table of mutations both files catch.
+ * test_terms.c, with the table of mutations these files catch.
  */
 #include <stdarg.h>
 #include <stddef.h>
@@ -21,6 +21,7 @@
 
 #include "sim/sim.h"
 #include "mesh_of.h"
+#include "terms_sim.h"
 
 /* A pinned horizontal triangle in y = 0, large enough that everything
  * above it here projects inside it, and a second cloth: a lone particle
@@ -67,11 +68,7 @@ static void scene_create_ordered(pair_scene *s, const double *floor_x, int ntop,
     s->def.dt = dt;
     s->def.fps = 1.0 / (steps_per_frame * dt);
     s->def.cg_tolerance = 1e-13;
-    char err[256] = "";
-    s->sim = cs_sim_create(&s->def, err, sizeof err);
-    if (!s->sim)
-        fail_msg("cs_sim_create: %s", err);
-    assert_true(fabs(cs_sim_dt(s->sim) / dt - 1) < 1e-12);
+    s->sim = create(&s->def);
 }
 
 static void scene_create(pair_scene *s, const double *floor_x, int ntop, const double *top_x,
@@ -179,7 +176,7 @@ static void check_friction_impulse(double vt, double w)
     scene_create(&s, big_floor, 1, p, 0, NULL, v0, dt, 1, 0);
     const cs_self_collision_def *self = &s.def.self;
     const double m = top_mass(&s), h = self->thickness;
-    assert_int_equal(cs_sim_advance_frame(s.sim, NULL), CS_OK);
+    advance(s.sim);
     double want = fmax(vt - self->friction * w, 0);
     double y1 = y0 + self->stiffness * dt * dt / m * (h - y0);
     const double *x = top_x(&s, 0), *v = top_v(&s, 0);
@@ -193,7 +190,7 @@ static void check_friction_impulse(double vt, double w)
         fail_msg("vt %g, w %g: position (%.12f, %.12f) after a step, exact (%.12f, %.12f)", vt,
                  w, x[0], x[1], p[0] + dt * vt, y1);
     for (int f = 0; f < 20; f++)
-        assert_int_equal(cs_sim_advance_frame(s.sim, NULL), CS_OK);
+        advance(s.sim);
     assert_true(fabs(top_v(&s, 0)[0] - want) < 1e-12);
     scene_destroy(&s);
 }
@@ -219,7 +216,7 @@ static void test_cloth_friction_sliding(void **state)
     scene_create(&s, big_floor, 1, p, 0, NULL, vel, dt, 200, -g);
     const double mu = s.def.self.friction, h = s.def.self.thickness;
     for (int f = 1; f <= 10; f++) {
-        assert_int_equal(cs_sim_advance_frame(s.sim, NULL), CS_OK);
+        advance(s.sim);
         double t = cs_sim_time(s.sim), want = v0 - mu * g * t;
         const double *x = top_x(&s, 0), *v = top_v(&s, 0);
         if (f == 10)
