@@ -158,6 +158,16 @@ static cs_sim *hanging_cloth(cs_trimesh **mesh, double dt, double stiffness, cha
     return sim;
 }
 
+/* The hanging cloth at the automatic step and its material's stiffness */
+static cs_sim *default_hanging_cloth(cs_trimesh **mesh)
+{
+    char err[512];
+    int status;
+    cs_sim *sim = hanging_cloth(mesh, 0, 0, err, sizeof err, &status);
+    assert_int_equal(status, CS_OK);
+    return sim;
+}
+
 /* Steps the scene cannot take are refused at creation with the reason, not
  * run: a step so small that a frame needs more than CS_MAX_STEPS_PER_FRAME
  * of them (it used to overflow an int and become one step per frame), and a
@@ -285,6 +295,37 @@ static void test_runaway_is_detected_with_its_stage(void **state)
     cs_trimesh_destroy(mesh);
 }
 
+
+/* B.6's velocity at a particle in body contact carries the contact impulse
+ * (the improved friction turns it into friction in B.7), so the check after
+ * velocity_full leaves such particles to the check after body_friction; a
+ * free particle as fast is caught at once. */
+static void test_runaway_waits_for_b7_at_contacts(void **state)
+{
+    (void)state;
+    cs_trimesh *mesh;
+    cs_sim *sim = default_hanging_cloth(&mesh);
+    int i = sim->n / 2; /* a free particle */
+    assert_true(sim->is_free[i]);
+    double *v = calloc(3 * (size_t)sim->n, sizeof *v);
+    cs_runaway_begin_step(sim, 0.1);
+    v[3 * i + 1] = -2 * sim->runaway.limit; /* into the body, past the limit */
+    sim->mode[i] = CS_CONTACT;
+    cs_runaway_check(sim, v, CS_STAGE_VELOCITY_FULL);
+    assert_false(cs_sim_runaway(sim, NULL, NULL, NULL));
+    cs_runaway_check(sim, v, CS_STAGE_BODY_FRICTION); /* B.7 did not remove it */
+    const char *stage = NULL;
+    assert_true(cs_sim_runaway(sim, &stage, NULL, NULL));
+    assert_string_equal(stage, "body_friction");
+    sim->runaway.stage = -1;
+    sim->mode[i] = CS_FREE;
+    cs_runaway_check(sim, v, CS_STAGE_VELOCITY_FULL);
+    assert_true(cs_sim_runaway(sim, &stage, NULL, NULL));
+    assert_string_equal(stage, "velocity_full");
+    free(v);
+    cs_sim_destroy(sim);
+    cs_trimesh_destroy(mesh);
+}
 
 /* Linear normal drag (Section 8): a horizontal sheet of areal density rho
  * falling in still air feels -c A (v.n) n per vertex and m = rho A, so every
@@ -460,6 +501,7 @@ int main(void)
         cmocka_unit_test(test_automatic_dt_is_stable_across_resolutions),
         cmocka_unit_test(test_impossible_steps_are_refused),
         cmocka_unit_test(test_runaway_is_detected_with_its_stage),
+        cmocka_unit_test(test_runaway_waits_for_b7_at_contacts),
         cmocka_unit_test(test_runaway_bound_keeps_what_scripts_gave),
         cmocka_unit_test(test_wind_drag_terminal_velocity),
         cmocka_unit_test(test_moving_body_drags_particle),
