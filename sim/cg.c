@@ -73,6 +73,14 @@ static inline void wind_block(const cs_sim *sim, int i, double B[6])
     B[5] += c * nd[1] * nd[2];
 }
 
+/* out = a symmetric 3 x 3 block stored as xx yy zz xy xz yz, times r */
+static inline void sym_block_apply(const double a[6], const double r[3], double out[3])
+{
+    out[0] = a[0] * r[0] + a[3] * r[1] + a[4] * r[2];
+    out[1] = a[3] * r[0] + a[1] * r[1] + a[5] * r[2];
+    out[2] = a[4] * r[0] + a[5] * r[1] + a[2] * r[2];
+}
+
 /* The particle's block m I + (dt/2) B of M - (dt/2) D (xx yy zz xy xz
  * yz); the damping acts along spring directions, which a diagonal alone
  * misses. A particle in contact moves only in its tangent plane, and CG
@@ -91,13 +99,11 @@ static inline void system_block(const cs_sim *sim, int i, const double B[6], dou
     if (sim->mode[i] != CS_CONTACT)
         return;
     const double *N = sim->contact_normal + 3 * i;
-    double u[3]; /* u = a N, c = N . a N */
-    u[0] = a[0] * N[0] + a[3] * N[1] + a[4] * N[2];
-    u[1] = a[3] * N[0] + a[1] * N[1] + a[5] * N[2];
-    u[2] = a[4] * N[0] + a[5] * N[1] + a[2] * N[2];
-    double c = cs_dot(N, u) + m;
+    double u[3];
+    sym_block_apply(a, N, u);
+    double c = cs_dot(N, u) + m; /* N . a N, plus the m N N^T part */
     static const int row[6] = {0, 1, 2, 0, 0, 1}, col[6] = {0, 1, 2, 1, 2, 2};
-    for (int k = 0; k < 6; k++) /* a - N u^T - u N^T + (c + m) N N^T */
+    for (int k = 0; k < 6; k++) /* a - N u^T - u N^T + c N N^T, u = a N */
         a[k] += -N[row[k]] * u[col[k]] - u[row[k]] * N[col[k]] + c * N[row[k]] * N[col[k]];
 }
 
@@ -127,21 +133,13 @@ static inline void project_row(const cs_sim *sim, int i, double a[3])
     }
 }
 
-/* out = the stored symmetric 3 x 3 inverse (xx yy zz xy xz yz) times r */
-static inline void precondition(const double inv[6], const double r[3], double out[3])
-{
-    out[0] = inv[0] * r[0] + inv[3] * r[1] + inv[4] * r[2];
-    out[1] = inv[3] * r[0] + inv[1] * r[1] + inv[5] * r[2];
-    out[2] = inv[4] * r[0] + inv[5] * r[1] + inv[2] * r[2];
-}
-
 /* y_i = P B_i^-1 r_i, adding r_i . y_i to *sum and raising *worst to the
  * squared residual in velocity units |r_i|^2 / m_i^2 (squared: no square
  * root or division per particle; the caller takes one root of the max) */
 static inline void precondition_row(const cs_sim *sim, int i, const double *ri, double *yi,
                                     double *sum, double *worst)
 {
-    precondition(sim->cg.block + 6 * i, ri, yi);
+    sym_block_apply(sim->cg.block + 6 * i, ri, yi); /* B_i^-1 r_i */
     project_row(sim, i, yi);
     for (int d = 0; d < 3; d++)
         *sum += ri[d] * yi[d];

@@ -259,10 +259,7 @@ static void test_runaway_is_detected_with_its_stage(void **state)
 {
     (void)state;
     cs_trimesh *mesh;
-    char err[512];
-    int status;
-    cs_sim *sim = hanging_cloth(&mesh, 0, 0, err, sizeof err, &status);
-    assert_int_equal(status, CS_OK);
+    cs_sim *sim = default_hanging_cloth(&mesh);
     double dt = 91 * cs_sim_undamped_dt(sim);
     int steps = 0, rc = CS_OK;
     while (rc == CS_OK && steps < 200) {
@@ -282,7 +279,7 @@ static void test_runaway_is_detected_with_its_stage(void **state)
     cs_sim_destroy(sim);
     cs_trimesh_destroy(mesh);
 
-    sim = hanging_cloth(&mesh, 0, 0, err, sizeof err, &status);
+    sim = default_hanging_cloth(&mesh);
     cs_frame_stats st;
     for (int f = 0; f < 60; f++) {
         if (cs_sim_advance_frame(sim, &st) != CS_OK) {
