@@ -6,8 +6,8 @@
  * with what the run came from, in HDF5 so that h5dump, h5py or any HDF5
  * reader can open it:
  *   /state/time, /state/positions (n x 3), /state/velocities (n x 3),
- *   /state/cg/warm_half, /state/cg/warm_full, /state/cg/warm_half_before,
- *   /state/cg/warm_full_before, /state/self_collision/x_free
+ *   /state/cg/warm_half, /state/cg/warm_full_less_half,
+ *   /state/cg/warm_half_before, /state/cg/warm_full_less_half_before, /state/self_collision/x_free
  *   /scene/text        the scene file's bytes when the run began
  *   /scene/overrides   its --set overrides, as given
  *   /run/totals        stage times and counts to carry the summary on

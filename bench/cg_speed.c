@@ -91,7 +91,7 @@ int main(int argc, char **argv)
             cs_system_apply(sim, v, out);
         apply = fmin(apply, (cs_now() - t0) / calls);
         t0 = cs_now();
-        iterations = cs_cg_solve(sim, v0, rhs, sol, NULL, NULL);
+        iterations = cs_cg_solve(sim, v0, rhs, sol, NULL, NULL, NULL);
         solve = fmin(solve, cs_now() - t0);
     }
     long entries = sim->springs.row_start[sim->springs.nrows];

@@ -5,8 +5,9 @@
  * - time t (the scripts' and bodies' poses, the frame count);
  * - positions x and velocities v (everything starts from them);
  * - the CG warm starts of B.1 and B.5 (cs_cg_solve adds a blend of the
- *   last two solves' damping responses to its start: the iterations, and
- *   so the bits of the result, depend on them);
+ *   last two solves' damping responses to its start, for B.5 their excess
+ *   over B.1's: the iterations, and so the bits of the result, depend on
+ *   them);
  * - with self-collision, the collision-free positions x_free (step A's
  *   pairs and step C's trajectories start there; equal to x at a frame
  *   end, stored anyway so nothing is inferred);
@@ -31,9 +32,9 @@ int cs_sim_state_arrays(cs_sim *sim, cs_state_array *a)
     a[k++] = (cs_state_array){"positions", n3, sim->x};
     a[k++] = (cs_state_array){"velocities", n3, sim->v};
     a[k++] = (cs_state_array){"cg/warm_half", n3, sim->cg.warm_half};
-    a[k++] = (cs_state_array){"cg/warm_full", n3, sim->cg.warm_full};
+    a[k++] = (cs_state_array){"cg/warm_full_less_half", n3, sim->cg.warm_full_less_half};
     a[k++] = (cs_state_array){"cg/warm_half_before", n3, sim->cg.warm_half_before};
-    a[k++] = (cs_state_array){"cg/warm_full_before", n3, sim->cg.warm_full_before};
+    a[k++] = (cs_state_array){"cg/warm_full_less_half_before", n3, sim->cg.warm_full_less_half_before};
     if (sim->selfcol)
         a[k++] = (cs_state_array){"self_collision/x_free", n3, sim->selfcol->x_free};
     if (sim->nscripts > 0)
@@ -50,9 +51,9 @@ void cs_sim_state_gather(cs_sim *sim)
     cs_comm_stats saved[CS_STAGE_COUNT];
     memcpy(saved, sim->par->stats, sizeof saved);
     cs_par_gather_root(sim->par, sim->cg.warm_half, 3);
-    cs_par_gather_root(sim->par, sim->cg.warm_full, 3);
+    cs_par_gather_root(sim->par, sim->cg.warm_full_less_half, 3);
     cs_par_gather_root(sim->par, sim->cg.warm_half_before, 3);
-    cs_par_gather_root(sim->par, sim->cg.warm_full_before, 3);
+    cs_par_gather_root(sim->par, sim->cg.warm_full_less_half_before, 3);
     memcpy(sim->par->stats, saved, sizeof saved);
 }
 

@@ -52,9 +52,10 @@ typedef struct cs_cg_work {
     double *z, *r, *y, *p, *q;
     double *explicit_z;          /* the explicit update CG starts from */
     double *block;               /* 6 per particle: the preconditioner's 3 x 3 inverse */
-    /* the damping responses of B.1's and B.5's last solves, and of the
-     * solves before those (cs_cg_solve starts from a blend of the two) */
-    double *warm_half, *warm_full, *warm_half_before, *warm_full_before;
+    /* the damping responses of B.1's last solve and of the one before,
+     * and B.5's less B.1's of the same step, also for the last two steps
+     * (cs_cg_solve starts from a blend of the two) */
+    double *warm_half, *warm_full_less_half, *warm_half_before, *warm_full_less_half_before;
     double *partial;  /* 2 per block: a partial sum and a partial maximum */
     double *inv_mass; /* 1 / m per particle: multiplies where the solve divided */
 } cs_cg_work;
@@ -126,11 +127,12 @@ int cs_sort_unique_pairs(int *pairs, int n);
  * where P projects out fixed velocities and contact normals, over all
  * ranks (v0's ghosts are refreshed first; v is written where owned).
  * warm and warm_before (3 per particle each, or both NULL) hold the
- * damping responses of the last two solves of the same kind, whose blend
- * is added to the start; they shift by one, warm receiving this one's.
+ * damping responses of the last two solves of the same kind, less base's
+ * (NULL: zero), and base plus their blend is added to the start; they
+ * shift by one, warm receiving this one's response less base.
  * Returns the iteration count, the same on every rank. */
-int cs_cg_solve(cs_sim *sim, const double *v0, const double *rhs, double *v, double *warm,
-                double *warm_before);
+int cs_cg_solve(cs_sim *sim, const double *v0, const double *rhs, double *v, const double *base,
+                double *warm, double *warm_before);
 /* out = (M - (dt/2) D) v, D the damping (and wind drag) velocity Jacobian. */
 void cs_system_apply(const cs_sim *sim, const double *v, double *out);
 /* out += D v (damping plus implicit wind drag). */

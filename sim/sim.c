@@ -241,8 +241,8 @@ int cs_sim_create_checked(const cs_sim_def *def, cs_sim **out, char *err, size_t
         double **scratch[] = {&sim->x_prev, &sim->v_half, &sim->v_star, &sim->v_next,
                               &sim->force, &sim->v0, &sim->rhs, &sim->cg.z, &sim->cg.r,
                               &sim->cg.y, &sim->cg.p, &sim->cg.q,
-                              &sim->cg.explicit_z, &sim->cg.warm_half, &sim->cg.warm_full,
-                              &sim->cg.warm_half_before, &sim->cg.warm_full_before};
+                              &sim->cg.explicit_z, &sim->cg.warm_half, &sim->cg.warm_full_less_half,
+                              &sim->cg.warm_half_before, &sim->cg.warm_full_less_half_before};
         for (size_t k = 0; k < sizeof scratch / sizeof *scratch && ok; k++)
             ok = (*scratch[k] = alloc3(n)) != NULL;
         ok = ok && (sim->cg.partial = calloc(2 * ((size_t)n / CS_BLOCK + 1), sizeof(double)));
@@ -462,7 +462,7 @@ void cs_sim_destroy(cs_sim *sim)
                         sim->script_v, sim->contact_normal, sim->wind_normal, sim->wind_area, sim->v_rewind,
                         sim->cg.z, sim->cg.r, sim->cg.y, sim->cg.p, sim->cg.q,
                         sim->cg.partial, sim->cg.explicit_z, sim->cg.warm_half,
-                        sim->cg.warm_full, sim->cg.warm_half_before, sim->cg.warm_full_before,
+                        sim->cg.warm_full_less_half, sim->cg.warm_half_before, sim->cg.warm_full_less_half_before,
                         sim->cg.block, sim->cg.inv_mass};
     for (size_t k = 0; k < sizeof arrays / sizeof *arrays; k++)
         free(arrays[k]);

@@ -230,8 +230,8 @@ static const double *stage_velocity_half(cs_sim *sim, const step_state *st)
             for (int d = 0; d < 3; d++)
                 sim->v0[3 * i + d] = (sim->script_x[3 * i + d] - sim->x[3 * i + d]) / st->dt;
     explicit_forces(sim, sim->x, sim->v, sim->t); /* prepares the springs' directions at x^n too */
-    sim->cg_iterations += cs_cg_solve(sim, sim->v0, sim->rhs, sim->v_half, sim->cg.warm_half,
-                                      sim->cg.warm_half_before);
+    sim->cg_iterations += cs_cg_solve(sim, sim->v0, sim->rhs, sim->v_half, NULL,
+                                      sim->cg.warm_half, sim->cg.warm_half_before);
     return sim->v_half;
 }
 
@@ -283,8 +283,11 @@ static const double *stage_velocity_full(cs_sim *sim, const step_state *st)
             sim->v_half[3 * i + d] = 0.5 * (sim->x_prev[3 * i + d] + sim->x[3 * i + d]);
     explicit_forces(sim, sim->v_half, sim->v_star, st->t1 - 0.5 * st->dt); /* at x^(n+1/2) */
     double *v_p = sim->v0; /* v0 is free again */
-    sim->cg_iterations += cs_cg_solve(sim, sim->v_star, sim->rhs, v_p, sim->cg.warm_full,
-                                      sim->cg.warm_full_before);
+    /* B.5's response is predicted as this step's B.1 response (the same
+     * springs, half a step later) plus how B.5's exceeded B.1's lately */
+    sim->cg_iterations += cs_cg_solve(sim, sim->v_star, sim->rhs, v_p, sim->cg.warm_half,
+                                      sim->cg.warm_full_less_half,
+                                      sim->cg.warm_full_less_half_before);
     if (st->bodies && sim->def.friction_method == CS_FRICTION_IMPROVED) {
         copy_ranges(par->local, par->nlocal, sim->v_next, sim->force);
         cs_halo_forward(par, &par->ghosts, v_p, 3);
