@@ -237,9 +237,10 @@ int cs_cg_solve(cs_sim *sim, const double *v0, const double *rhs, double *v, con
      * the history is of this solve's excess over base, and base is added:
      * B.1's response already holds what changed since the last step.
      * Total CG iterations, B.5 predicted from its own history against
-     * from B.1's: 50 x 50 bench, 48 frames, 78,885 -> 53,922 (damped
+     * from B.1's: 50 x 50 bench, 48 frames, 78,885 -> 53,837 (damped
      * limit 67,648 -> 55,684); 100 x 100 damped, 24 frames, 98,824 ->
-     * 88,298; 200 x 200 damped, frames 9-12, 102,857 -> 96,346. B.1
+     * 88,717; 200 x 200 damped, frames 1-8 17,740 -> 13,877 and the
+     * landing, frames 9-12, 102,857 -> 96,440. B.1
      * predicted likewise from B.5 gained nothing (98,824 -> 98,689): the
      * velocity is extrapolated between them (B.6), which flips the
      * hardest-damped modes. The explicit update leaves the damping out so
