@@ -249,9 +249,9 @@ static void prepare_rows(cs_springs *s, const double *x, double *f, bool keep_ma
         const double *xi = x + 3 * i;
         cs_pair2 fx = {0, 0}, fy = {0, 0}, fz = {0, 0};
         for (int e = s->row_start[r]; e < s->row_start[r + 1]; e += 2) {
-            cs_pair2 ux = cs_pair2_gather(x, s->row_other, e, 0, xi[0]);
-            cs_pair2 uy = cs_pair2_gather(x, s->row_other, e, 1, xi[1]);
-            cs_pair2 uz = cs_pair2_gather(x, s->row_other, e, 2, xi[2]);
+            cs_pair2 u[3];
+            cs_pair2_gather(x, s->row_other, e, xi, u);
+            cs_pair2 ux = u[0], uy = u[1], uz = u[2];
             cs_pair2 l = pair2_sqrt(ux * ux + uy * uy + uz * uz);
             /* one division: E (l / L0 - 1) / l = E / L0 - E / l, and u / l;
              * coincident ends (and the pads) have no direction to push
