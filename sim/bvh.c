@@ -1,6 +1,7 @@
 /* bvh.c: build, refit and pair traversal of box hierarchies. */
 #include <math.h>
 #include <limits.h>
+#include <stddef.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -142,6 +143,35 @@ static bool push_pair(cs_index_pairs *l, int a, int b)
     return true;
 }
 
+void cs_bvh_set_vertices(cs_bvh *t, const int *vertices, int nvertices)
+{
+    t->vertices = vertices;
+    t->nvertices = nvertices;
+}
+
+/* Primitive k's particles: vertices + nvertices * k, or k itself; their
+ * count in *n. */
+static inline const int *prim_vertices(const cs_bvh *t, const int *k, int *n)
+{
+    *n = t->vertices ? t->nvertices : 1;
+    return t->vertices ? t->vertices + (ptrdiff_t)t->nvertices * *k : k;
+}
+
+/* Pairs sharing a particle are never a collision pair (the makers reject
+ * them first), and such pairs always overlap: on the 100 x 100 bench they
+ * were about 60,000 of 73,000 point/triangle and 150,000 of 207,000
+ * edge/edge box overlaps per search of the kept pairs. */
+static inline bool share_vertex(const cs_bvh *A, int a, const cs_bvh *B, int b)
+{
+    int na, nb;
+    const int *va = prim_vertices(A, &a, &na), *vb = prim_vertices(B, &b, &nb);
+    for (int p = 0; p < na; p++)
+        for (int q = 0; q < nb; q++)
+            if (va[p] == vb[q])
+                return true;
+    return false;
+}
+
 static void leaf_pairs(traversal *tr, int i, int j)
 {
     const cs_bvh *A = tr->A, *B = tr->B;
@@ -153,6 +183,8 @@ static void leaf_pairs(traversal *tr, int i, int j)
             if (!cs_box_overlap(ba, B->leaf_box + kb))
                 continue;
             int b = B->order[kb];
+            if (share_vertex(A, a, B, b))
+                continue;
             bool ok = tr->self && a > b ? push_pair(tr->out, b, a) : push_pair(tr->out, a, b);
             tr->failed |= !ok;
         }

@@ -22,6 +22,10 @@ typedef struct cs_bvh {
     int *order;           /* primitive ids in leaf order */
     cs_box *leaf_box;     /* their boxes in leaf order, from the last refit */
     int *rank_lo, *rank_hi; /* per node: the ranks its primitives go to */
+    /* each primitive's particles, nvertices apiece (cs_bvh_set_vertices;
+     * NULL: primitive k is particle k) */
+    const int *vertices;
+    int nvertices;
 } cs_bvh;
 
 int cs_bvh_build(cs_bvh *t, int nprims, const cs_box *prim_box);
@@ -32,6 +36,11 @@ void cs_bvh_refit(cs_bvh *t, const cs_box *prim_box);
 /* Section 7: each primitive's rank (the lowest owner of its particles); a
  * pair goes to the lower of its two primitives' ranks. */
 int cs_bvh_set_ranks(cs_bvh *t, const int *prim_rank);
+
+/* Names each primitive's particles (kept, not copied), nvertices apiece,
+ * so that cs_bvh_collect leaves out pairs sharing one: a triangle and its
+ * own vertex, two edges with a common end. */
+void cs_bvh_set_vertices(cs_bvh *t, const int *vertices, int nvertices);
 
 /* Primitive pairs as (a, b) integer pairs, 2 ints each. */
 typedef struct cs_index_pairs {
@@ -48,8 +57,8 @@ typedef struct cs_bvh_work {
 } cs_bvh_work;
 void cs_bvh_work_free(cs_bvh_work *w);
 
-/* Every pair of primitives a of A and b of B whose boxes overlap (for
- * A == B each unordered pair once, as a < b), into out in the order of a
+/* Every pair of primitives a of A and b of B whose boxes overlap and that
+ * share no particle (for A == B each unordered pair once, as a < b), into out in the order of a
  * depth-first traversal whatever the thread count: the node pairs near the
  * top become tasks that OpenMP threads traverse into their own lists,
  * joined in task order. The boxes are those of the last cs_bvh_refit of

@@ -159,6 +159,8 @@ cs_selfcol *cs_selfcol_create(const cs_sim *sim)
     if (cs_bvh_build(&sc->ptree, n, sc->pbox) || cs_bvh_build(&sc->etree, ne, sc->ebox) ||
         cs_bvh_build(&sc->ttree, nt, sc->tbox))
         goto fail;
+    cs_bvh_set_vertices(&sc->etree, sc->edge, 2);
+    cs_bvh_set_vertices(&sc->ttree, sc->tri, 3);
     if (sc_cache_create(sc))
         goto fail;
     sc->bytes = sizeof(cs_box) * (size_t)(n + ne + nt) * 4 + sizeof(double) * 13 * (size_t)n +
