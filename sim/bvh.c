@@ -180,7 +180,7 @@ static void leaf_pairs(traversal *tr, int i, int j)
         const cs_box *ba = A->leaf_box + ka;
         int kb0 = (tr->self && i == j) ? ka + 1 : B->first[j];
         for (int kb = kb0; kb < B->first[j] + B->count[j]; kb++) {
-            if (!cs_box_overlap(ba, B->leaf_box + kb))
+            if (!cs_box_overlap_branchless(ba, B->leaf_box + kb))
                 continue;
             int b = B->order[kb];
             if (share_vertex(A, a, B, b))

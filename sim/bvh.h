@@ -74,6 +74,15 @@ static inline bool cs_box_overlap(const cs_box *a, const cs_box *b)
            b->lo[1] <= a->hi[1] && a->lo[2] <= b->hi[2] && b->lo[2] <= a->hi[2];
 }
 
+/* The same test with all six comparisons and no early exit, for the
+ * inner loops where the outcome is unpredictable (a leaf pair's boxes,
+ * the kept candidates): there the early exits were mispredicted. */
+static inline bool cs_box_overlap_branchless(const cs_box *a, const cs_box *b)
+{
+    return (a->lo[0] <= b->hi[0]) & (b->lo[0] <= a->hi[0]) & (a->lo[1] <= b->hi[1]) &
+           (b->lo[1] <= a->hi[1]) & (a->lo[2] <= b->hi[2]) & (b->lo[2] <= a->hi[2]);
+}
+
 static inline void cs_box_empty(cs_box *b)
 {
     for (int d = 0; d < 3; d++) {
