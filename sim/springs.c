@@ -308,8 +308,8 @@ static inv_lengths_fn wide_inv_lengths(void)
 }
 
 /* The row arrays the elastic pass reads and writes, copied out of the
- * springs: its stores (memcpy) may alias anything, and read through the
- * struct every pointer was loaded again for each pair (8% of the pass). */
+ * springs: its stores (memcpy) may alias anything, so read through the
+ * struct every pointer would be loaded again for each pair. */
 typedef struct row_arrays {
     const double *stiffness, *inv_rest_length, *sqrt_damping;
     double *direction, *magnitude;
