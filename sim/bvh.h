@@ -58,13 +58,13 @@ typedef struct cs_bvh_work {
 void cs_bvh_work_free(cs_bvh_work *w);
 
 /* Every pair of primitives a of A and b of B whose boxes overlap and that
- * share no particle (for A == B each unordered pair once, as a < b), into out in the order of a
- * depth-first traversal whatever the thread count: the node pairs near the
- * top become tasks that OpenMP threads traverse into their own lists,
- * joined in task order. The boxes are those of the last cs_bvh_refit of
- * each tree. With rank >= 0 (after cs_bvh_set_ranks on both trees),
- * node pairs that cannot hold a pair going to rank. Returns 0 or -1 (no
- * memory). */
+ * share no particle (for A == B each unordered pair once, as a < b), into
+ * out in the order of a depth-first traversal whatever the thread count:
+ * the node pairs near the top become tasks that OpenMP threads traverse
+ * into their own lists, joined in task order. The boxes are those of the
+ * last cs_bvh_refit of each tree. With rank >= 0 (after cs_bvh_set_ranks
+ * on both trees), node pairs that cannot hold a pair going to rank.
+ * Returns 0 or -1 (no memory). */
 int cs_bvh_collect(const cs_bvh *A, const cs_bvh *B, int rank, cs_bvh_work *w,
                    cs_index_pairs *out);
 

@@ -205,8 +205,8 @@ int sc_find_pairs(cs_selfcol *sc, bool edges, bool only_dirty, pair_maker make, 
         for (int k = 0; k < cand->n; k++) {
             int a = cand->ab[2 * k], b = cand->ab[2 * k + 1];
             cs_pair p;
-            if ((only_dirty && !da[a] && !db[b]) || !cs_box_overlap_branchless(boxa + a, boxb + b) ||
-                !make(ctx, a, b, &p))
+            if ((only_dirty && !da[a] && !db[b]) ||
+                !cs_box_overlap_branchless(boxa + a, boxb + b) || !make(ctx, a, b, &p))
                 continue;
             failed |= made_push(mine, a, b, &p);
         }

@@ -236,15 +236,6 @@ static inline cs_pair2 pair2_sqrt(cs_pair2 a)
 #endif
 }
 
-/* Seen from either end, a spring's terms are the same expression in
- * (self, other): u = x_other - x_self pulls self towards other when
- * stretched, and (v_other - v_self) . u_hat damps their approach. Every
- * row computes its own entries, so a spring between two rows is computed
- * twice; the two give the same direction negated and the same magnitude
- * (x_i - x_j = -(x_j - x_i) in floating point), and a row needs nothing
- * another thread writes: the elastic forces come in the same pass. (One
- * computation per spring, written to both ends, cost a second pass and
- * scattered writes; in pairs, two sqrt and divisions cost one.) */
 /* inv[k] = 1 / sqrt(uu[k]) where sqrt(uu[k]) > 0, else 0, for k < n (n
  * even): the elastic pass's square roots and divisions, a third of its
  * time (bench_cg_speed at 100 x 100, 2 threads: 213 us a pass, 150 with
@@ -445,9 +436,20 @@ prepare_rows_pairs(cs_springs *s, const double *x, double *f, bool keep_magnitud
     }
 }
 
-/* Either way each row's entries take the same operations in the same
- * order: the same bits with any kernel and thread count. Everything above
- * is inlined here, so the two callers' keep_magnitude is a constant. */
+/* Seen from either end, a spring's terms are the same expression in
+ * (self, other): u = x_other - x_self pulls self towards other when
+ * stretched, and (v_other - v_self) . u_hat damps their approach. Every
+ * row computes its own entries, so a spring between two rows is computed
+ * twice; the two give the same direction negated and the same magnitude
+ * (x_i - x_j = -(x_j - x_i) in floating point), and a row needs nothing
+ * another thread writes: the elastic forces come in the same pass. (One
+ * computation per spring, written to both ends, cost a second pass and
+ * scattered writes; in pairs, two sqrt and divisions cost one.)
+ *
+ * Either way (batched or pairs) each row's entries take the same
+ * operations in the same order: the same bits with any kernel and thread
+ * count. Everything above is inlined here, so the two callers'
+ * keep_magnitude is a constant. */
 static inline __attribute__((always_inline)) void
 prepare_rows(cs_springs *s, const double *x, double *f, bool keep_magnitude)
 {
