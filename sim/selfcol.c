@@ -717,6 +717,8 @@ void cs_selfcol_find_pairs(cs_sim *sim, double span)
     for (int i = 0; i < sc->n; i++) {
         double rel[3], end[3];
         cs_sub(sim->v + 3 * i, mean, rel);
+        for (int d = 0; d < 3; d++)
+            sc->cache.drift[3 * i + d] = rel[d] * span;
         cs_box_empty(sc->pbox + i);
         cs_box_add_point(sc->pbox + i, x + 3 * i);
         if (path) {

@@ -65,6 +65,10 @@ typedef struct cs_pair_cache {
     double anchor[3];            /* the centroid of x_free when it was built */
     cs_box *pbox, *ebox, *tbox;  /* the boxes it was built from, grown */
     cs_index_pairs pt, ee;       /* point/triangle, edge/edge */
+    double *drift;               /* per particle: its motion relative to the
+                                    centroid over step A's span, from the
+                                    last step A (the forecast below) */
+    int served;                  /* searches since it was built */
 } cs_pair_cache;
 
 typedef struct cs_selfcol {
