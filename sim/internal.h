@@ -56,7 +56,7 @@ typedef struct cs_cg_work {
      * and B.5's less B.1's of the same step, also for the last two steps
      * (cs_cg_solve starts from a blend of the two) */
     double *warm_half, *warm_full_less_half, *warm_half_before, *warm_full_less_half_before;
-    double *partial;  /* 2 per block: a partial sum and a partial maximum */
+    double *partial;  /* 3 per block: two partial sums and a partial maximum */
     double *inv_mass; /* 1 / m per particle: multiplies where the solve divided */
 } cs_cg_work;
 

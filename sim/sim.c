@@ -245,7 +245,7 @@ int cs_sim_create_checked(const cs_sim_def *def, cs_sim **out, char *err, size_t
                               &sim->cg.warm_half_before, &sim->cg.warm_full_less_half_before};
         for (size_t k = 0; k < sizeof scratch / sizeof *scratch && ok; k++)
             ok = (*scratch[k] = alloc3(n)) != NULL;
-        ok = ok && (sim->cg.partial = calloc(2 * ((size_t)n / CS_BLOCK + 1), sizeof(double)));
+        ok = ok && (sim->cg.partial = calloc(3 * ((size_t)n / CS_BLOCK + 1), sizeof(double)));
         ok = ok && (sim->cg.block = calloc(6 * (size_t)n + 6, sizeof(double)));
         ok = ok && (sim->cg.inv_mass = calloc((size_t)n + 1, sizeof(double)));
     }
