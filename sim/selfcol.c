@@ -163,7 +163,7 @@ cs_selfcol *cs_selfcol_create(const cs_sim *sim)
     cs_bvh_set_vertices(&sc->ttree, sc->tri, 3);
     if (sc_cache_create(sc))
         goto fail;
-    sc->bytes = sizeof(cs_box) * (size_t)(n + ne + nt) * 4 + sizeof(double) * 13 * (size_t)n +
+    sc->bytes = sizeof(cs_box) * (size_t)(n + ne + nt) * 4 + sizeof(double) * 16 * (size_t)n +
                 sizeof(int) * (size_t)(2 * ne + 3 * nt + 3 * n + most);
     return sc;
 fail:

@@ -67,7 +67,7 @@ typedef struct cs_pair_cache {
     cs_index_pairs pt, ee;       /* point/triangle, edge/edge */
     double *drift;               /* per particle: its motion relative to the
                                     centroid over step A's span, from the
-                                    last step A (the forecast below) */
+                                    last step A (selfcol_cache.c's forecast) */
     int served;                  /* searches since it was built */
 } cs_pair_cache;
 
