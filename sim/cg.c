@@ -179,7 +179,6 @@ void cs_system_apply(const cs_sim *sim, const double *v, double *out)
  * in a run on this VM against 1.5 us for a barrier, 30 times a step at
  * 100 x 100. Messages (more than one rank) go through one thread, the
  * others waiting at the end of its single block. */
-static bool ranks(const cs_par *par) { return par->mpi && par->size > 1; }
 
 /* Sums block partials in block order and over ranks (with the maximum of
  * the block maxima when max is given); called by every thread. */
@@ -192,7 +191,7 @@ static double reduce(cs_sim *sim, const double *sum, const double *max, double *
         if (max && max[b] > m)
             m = max[b];
     }
-    if (ranks(sim->par)) {
+    if (cs_par_distributed(sim->par)) {
 #pragma omp single copyprivate(s, m)
         {
             if (max)
@@ -210,7 +209,7 @@ static double reduce(cs_sim *sim, const double *sum, const double *max, double *
  * after a barrier */
 static void forward_ghosts(cs_par *par, double *a)
 {
-    if (ranks(par)) {
+    if (cs_par_distributed(par)) {
 #pragma omp single
         cs_halo_forward(par, &par->ghosts, a, 3);
     }

@@ -400,7 +400,7 @@ void cs_halo_reverse(cs_par *p, const cs_halo *h, double *a, int width)
 /* Packs owned values in order; unpacks all into a. */
 static void gather(cs_par *p, double *a, int width, bool to_all)
 {
-    if (!p->mpi || p->size == 1)
+    if (!cs_par_distributed(p))
         return;
     double t0 = cs_now();
     double *buf = buffer(p, (size_t)width * (size_t)p->n + (size_t)width * p->nowned + 1);
@@ -438,7 +438,7 @@ void cs_par_gather_root(cs_par *p, double *a, int width) { gather(p, a, width, f
 
 static void reduce(cs_par *p, void *a, int count, MPI_Datatype type, MPI_Op op, size_t size)
 {
-    if (!p->mpi || p->size == 1)
+    if (!cs_par_distributed(p))
         return;
     double t0 = cs_now();
     MPI_Allreduce(MPI_IN_PLACE, a, count, type, op, p->comm);
@@ -465,7 +465,7 @@ int cs_par_allgather_items(cs_par *p, const void *items, int count, size_t size,
 {
     *out = NULL;
     *nout = 0;
-    if (!p->mpi || p->size == 1) {
+    if (!cs_par_distributed(p)) {
         void *copy = malloc(size * (size_t)count + 1);
         if (!copy)
             return -1;
@@ -512,7 +512,7 @@ void cs_par_report(cs_par *p, const cs_stage_timing *timing, cs_stage_timing *ti
         total.bytes += p->stats[s].bytes;
         total.messages += p->stats[s].messages;
     }
-    if (!p->mpi || p->size == 1) {
+    if (!cs_par_distributed(p)) {
         memcpy(timing_all, timing, sizeof *timing * CS_STAGE_COUNT);
         memcpy(comm_all, p->stats, sizeof *comm_all * CS_STAGE_COUNT);
         rank_comm[0] = total;
@@ -551,7 +551,7 @@ void cs_par_report(cs_par *p, const cs_stage_timing *timing, cs_stage_timing *ti
 
 int cs_par_bcast_int(cs_par *p, int value)
 {
-    if (p->mpi && p->size > 1)
+    if (cs_par_distributed(p))
         MPI_Bcast(&value, 1, MPI_INT, 0, p->comm);
     return value;
 }
@@ -638,7 +638,7 @@ static void sum_max_op(void *in, void *inout, int *len, MPI_Datatype *type)
 
 void cs_par_sum_max(cs_par *p, double *sum, double *max)
 {
-    if (!p->mpi || p->size == 1)
+    if (!cs_par_distributed(p))
         return;
     double t0 = cs_now();
     if (p->sum_max == MPI_OP_NULL)

@@ -81,6 +81,9 @@ void cs_par_destroy(cs_par *p);
  * n points, sizes differing by at most one per level. */
 void cs_par_median_split(int n, const double *x, int parts, int *owner);
 
+/* True when the particles are shared among ranks, so messages go between
+ * them (false for one rank, with MPI or without) */
+static inline bool cs_par_distributed(const cs_par *p) { return p->mpi && p->size > 1; }
 static inline bool cs_par_owns(const cs_par *p, int i) { return p->owner[i] == p->rank; }
 /* This rank's particles, ascending (nowned of them). */
 static inline const int *cs_par_owned(const cs_par *p) { return p->order + p->displs[p->rank]; }

@@ -717,13 +717,14 @@ void cs_selfcol_find_pairs(cs_sim *sim, double span)
     for (int i = 0; i < sc->n; i++) {
         double rel[3], end[3];
         cs_sub(sim->v + 3 * i, mean, rel);
+        double *drift = sc->cache.drift + 3 * i; /* the motion over the span */
         for (int d = 0; d < 3; d++)
-            sc->cache.drift[3 * i + d] = rel[d] * span;
+            drift[d] = rel[d] * span;
         cs_box_empty(sc->pbox + i);
         cs_box_add_point(sc->pbox + i, x + 3 * i);
         if (path) {
             for (int d = 0; d < 3; d++)
-                end[d] = x[3 * i + d] + rel[d] * span;
+                end[d] = x[3 * i + d] + drift[d];
             cs_box_add_point(sc->pbox + i, end);
             cs_box_thicken(sc->pbox + i, 0.5 * thickness);
         } else {
