@@ -10,6 +10,7 @@
 #include <string.h>
 
 #include "sim/internal.h"
+#include "sim/shares.h"
 #include "sim/vec3.h"
 
 static int block_count(const cs_par *par) { return (par->nowned + CS_BLOCK - 1) / CS_BLOCK; }
@@ -215,14 +216,23 @@ static void forward_ghosts(cs_par *par, double *a)
     }
 }
 
-/* The loops walk blocks of the owned list: rows [r0, r1) of block b,
- * shared among the threads of the enclosing region. */
-#define FOR_BLOCKS(sim, b, r0, r1)                                                   \
-    _Pragma("omp for schedule(static)")                                              \
-    for (int b = 0; b < block_count((sim)->par); b++)                                \
+/* The loops walk blocks of the owned list: rows [r0, r1) of block b, the
+ * calling thread's share of the blocks (shares.h: shares follow the
+ * threads' measured speeds). Each pass clocks its thread from t0 and
+ * ends at a barrier of its own (END_PASS). */
+#define FOR_MY_BLOCKS(sim, t0, b, r0, r1)                                            \
+    for (int b = ((t0) = omp_get_wtime(),                                            \
+                  cs_shares_bound(&(sim)->shares, block_count((sim)->par), 0)),       \
+             b##_end = cs_shares_bound(&(sim)->shares, block_count((sim)->par), 1);   \
+         b < b##_end; b++)                                                           \
         for (int r0 = b * CS_BLOCK, r1 = r0 + CS_BLOCK < (sim)->par->nowned          \
                                              ? r0 + CS_BLOCK : (sim)->par->nowned;   \
              r0 < r1; r0 = r1)
+#define END_PASS(sim, t0)                                                            \
+    do {                                                                             \
+        cs_shares_clock(&(sim)->shares, t0);                                         \
+        _Pragma("omp barrier")                                                       \
+    } while (0)
 
 /* The warm start's weight on the damping response of the solve before the
  * last (the last's is 1 minus it). Table 1's damping is 15 times critical,
@@ -277,8 +287,9 @@ int cs_cg_solve(cs_sim *sim, const double *v0, const double *rhs, double *v, con
      * directions (two passes before; the warm start carries the damping). */
 #pragma omp parallel
     {
-#pragma omp for schedule(static)
-        for (int r = 0; r < par->nowned; r++) {
+        double t0; /* the start of this thread's part of a pass */
+        FOR_MY_BLOCKS(sim, t0, b, r0, r1)
+        for (int r = r0; r < r1; r++) {
             int i = own[r];
             double ri[3];
             for (int d = 0; d < 3; d++)
@@ -299,11 +310,12 @@ int cs_cg_solve(cs_sim *sim, const double *v0, const double *rhs, double *v, con
                 w->y[3 * i + d] = v0[3 * i + d] + w->z[3 * i + d];
             }
         }
+        END_PASS(sim, t0);
         forward_ghosts(par, w->y);
         /* r = P (rhs - A y), p = P B^-1 r, with B the diagonal blocks of A
          * (y is read across particles here, so the preconditioned residual
          * goes straight into p) */
-        FOR_BLOCKS(sim, b, r0, r1) {
+        FOR_MY_BLOCKS(sim, t0, b, r0, r1) {
             double sum = 0, worst = 0;
             for (int r = r0; r < r1; r++) {
                 int i = own[r];
@@ -325,6 +337,7 @@ int cs_cg_solve(cs_sim *sim, const double *v0, const double *rhs, double *v, con
             part_sum[b] = sum;
             part_max[b] = worst;
         }
+        END_PASS(sim, t0);
         double residual = 0, rho = reduce(sim, part_sum, part_max, &residual);
 
         /* Two passes an iteration: the direction's update p = y + beta p is
@@ -338,7 +351,7 @@ int cs_cg_solve(cs_sim *sim, const double *v0, const double *rhs, double *v, con
         while (it < sim->def.cg_max_iterations && residual > sim->def.cg_tolerance) {
             double *operand = it == 0 ? w->p : w->y;
             forward_ghosts(par, operand);
-            FOR_BLOCKS(sim, b, r0, r1) { /* z += alpha p, p = y + beta p, q = P A p, p . q */
+            FOR_MY_BLOCKS(sim, t0, b, r0, r1) { /* z += alpha p, p = y + beta p, q = P A p, p . q */
                 double sum = 0;
                 for (int r = r0; r < r1; r++) {
                     int i = own[r];
@@ -358,6 +371,7 @@ int cs_cg_solve(cs_sim *sim, const double *v0, const double *rhs, double *v, con
                 }
                 op_sum[b] = sum;
             }
+            END_PASS(sim, t0);
             pending = 0; /* the pass above took it into z */
             double pq = reduce(sim, op_sum, NULL, NULL);
             if (!(pq > 0))
@@ -367,7 +381,7 @@ int cs_cg_solve(cs_sim *sim, const double *v0, const double *rhs, double *v, con
              * the last one below): this pass then reads neither p nor z, and z
              * gets the same sums in the same order */
             pending = alpha;
-            FOR_BLOCKS(sim, b, r0, r1) {
+            FOR_MY_BLOCKS(sim, t0, b, r0, r1) {
                 double sum = 0, worst = 0;
                 for (int r = r0; r < r1; r++) {
                     int i = own[r];
@@ -379,13 +393,14 @@ int cs_cg_solve(cs_sim *sim, const double *v0, const double *rhs, double *v, con
                 part_sum[b] = sum;
                 part_max[b] = worst;
             }
+            END_PASS(sim, t0);
             double rho_next = reduce(sim, part_sum, part_max, &residual);
             beta = rho_next / rho;
             rho = rho_next;
             it++;
         }
-#pragma omp for schedule(static) nowait
-        for (int r = 0; r < par->nowned; r++)
+        FOR_MY_BLOCKS(sim, t0, b, r0, r1)
+        for (int r = r0; r < r1; r++)
             for (int d = 0; d < 3; d++) {
                 int k = 3 * own[r] + d;
                 /* only a pending step is added: z + 0 p would turn a -0 into
@@ -397,8 +412,10 @@ int cs_cg_solve(cs_sim *sim, const double *v0, const double *rhs, double *v, con
                     warm[k] = z - w->explicit_z[k] - (base ? base[k] : 0.0);
                 }
             }
+        cs_shares_clock(&sim->shares, t0); /* the region's end is the barrier */
 #pragma omp master
         iterations = it;
     }
+    cs_shares_update(&sim->shares);
     return iterations;
 }

@@ -6,6 +6,7 @@
 #include "sim/par.h"
 #include "sim/sim.h"
 #include "sim/selfcol.h"
+#include "sim/shares.h"
 #include "sim/springs.h"
 
 /* What the solver may change about a particle's velocity. */
@@ -87,6 +88,7 @@ struct cs_sim {
     /* step scratch */
     double *x_prev, *v_half, *v_star, *v_next, *force, *v0, *rhs;
     cs_cg_work cg;
+    cs_shares shares;             /* the owned rows' split among the threads */
     /* body stages only */
     double *contact_normal;       /* 3 per particle */
     int *contact_body;            /* -1 when not in contact */

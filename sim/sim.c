@@ -415,8 +415,10 @@ int cs_sim_create_checked(const cs_sim_def *def, cs_sim **out, char *err, size_t
     if (!sim->par || !sim->active || !sim->rank_comm)
         goto nomem;
     cs_springs_keep_touching(&sim->springs, sim->par->owner, sim->par->rank);
-    if (cs_springs_index(&sim->springs, sim->par->nowned, cs_par_owned(sim->par), n))
+    if (cs_springs_index(&sim->springs, sim->par->nowned, cs_par_owned(sim->par), n) ||
+        cs_shares_init(&sim->shares, sim->par->nowned, CS_BLOCK))
         goto nomem;
+    sim->springs.shares = &sim->shares; /* its rows are the owned particles too */
     if (sim->selfcol && cs_selfcol_set_ranks(sim) != 0)
         goto nomem;
     for (int i = 0; i < n; i++)
@@ -453,6 +455,7 @@ void cs_sim_destroy(cs_sim *sim)
         free((void *)sim->bodies[b].motion.keys);
     free(sim->bodies);
     cs_springs_free(&sim->springs);
+    cs_shares_free(&sim->shares);
     cs_selfcol_destroy(sim->selfcol);
     cs_par_destroy(sim->par);
     free(sim->active);

@@ -11,6 +11,7 @@
 #include <immintrin.h> /* the wider kernels, compiled for their targets alone */
 #endif
 
+#include "sim/shares.h"
 #include "sim/springs.h"
 #include "sim/vec3.h"
 
@@ -462,14 +463,15 @@ prepare_rows(cs_springs *s, const double *x, double *f, bool keep_magnitude)
     inv_lengths_fn inv_lengths = wide;
 #pragma omp parallel
     {
-        /* contiguous equal shares of the rows, as schedule(static) */
-        int threads = omp_get_num_threads(), me = omp_get_thread_num();
-        int r = (int)((long)s->nrows * me / threads);
-        int r_end = (int)((long)s->nrows * (me + 1) / threads);
+        /* the thread's share of the rows, clocked (shares.h) */
+        double t0 = omp_get_wtime();
+        int r, r_end;
+        cs_shares_rows(s->shares, s->nrows, &r, &r_end);
         if (inv_lengths)
             prepare_rows_batched(s, x, f, keep_magnitude, inv_lengths, r, r_end);
         else
             prepare_rows_pairs(s, x, f, keep_magnitude, r, r_end);
+        cs_shares_clock(s->shares, t0);
     }
 }
 

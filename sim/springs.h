@@ -43,6 +43,8 @@ typedef struct cs_springs {
      * from row_direction + 3 * 2p), so one load fills a pair. */
     double *row_sqrt_damping, *row_stiffness, *row_inv_rest_length;
     double *row_direction, *row_magnitude;
+    /* how the rows are split among the threads (shares.h); NULL: equally */
+    struct cs_shares *shares;
 } cs_springs;
 
 /* Appends the edge and bending springs of a triangle mesh whose vertices are

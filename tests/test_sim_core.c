@@ -9,6 +9,7 @@
 #include <cmocka.h>
 
 #include <math.h>
+#include <omp.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -258,6 +259,83 @@ static void test_cg_matches_dense_solve(void **state)
     cs_trimesh_destroy(mesh);
 }
 
+/* Thread shares (shares.h) follow the threads' measured speeds, a stall
+ * moves them only so far, a thread that stalls for good keeps a quarter of
+ * an equal share; and where the rows go changes no bit of CG's answer. */
+static void set_busy(cs_shares *s, const double *speed)
+{
+    for (int t = 0; t < s->threads; t++)
+        s->clock[t].busy = (s->first[t + 1] - s->first[t]) * (double)s->block / speed[t];
+}
+
+static void test_thread_shares(void **state)
+{
+    (void)state;
+    int threads_before = omp_get_max_threads();
+    omp_set_num_threads(2);
+    cs_shares s;
+    assert_int_equal(cs_shares_init(&s, 64 * 90 - 10, 64), 0);
+    assert_int_equal(s.nblocks, 90);
+    assert_int_equal(s.first[1], 45);
+    double half[2] = {1e6, 0.5e6}; /* rows per second: thread 1 at half speed */
+    for (int k = 0; k < 40; k++) {
+        set_busy(&s, half);
+        cs_shares_update(&s);
+    }
+    assert_true(abs(s.first[1] - 60) <= 1); /* two thirds of the rows to thread 0 */
+    double stalled[2] = {1e6, 0.5e6 / 100}; /* descheduled for one solve */
+    int was = s.first[1];
+    set_busy(&s, stalled);
+    cs_shares_update(&s);
+    assert_true(s.first[1] > was && s.first[1] <= was + 4);
+    double gone[2] = {1e6, 1.0};
+    for (int k = 0; k < 100; k++) {
+        set_busy(&s, gone);
+        cs_shares_update(&s);
+    }
+    assert_int_equal(s.first[1], 80); /* 90 / (1 + 1/8) */
+    assert_int_equal(s.first[2], 90);
+    cs_shares_free(&s);
+
+    /* the same solve under three splits of its four blocks (196 particles) */
+    cs_cloth_def cloth;
+    cs_trimesh *mesh;
+    cs_sim_def def = grid_def(&cloth, &mesh, 13, 13);
+    cs_sim *sim = cs_sim_create(&def, NULL, 0);
+    assert_non_null(sim);
+    assert_int_equal(sim->shares.threads, 2);
+    assert_int_equal(sim->shares.nblocks, 4);
+    int n3 = 3 * sim->n;
+    sim->half_dt = 0.5e-3;
+    cs_springs_prepare(&sim->springs, sim->x);
+    for (int i = 0; i < sim->n; i++)
+        sim->mode[i] = CS_FREE;
+    double *rhs = calloc((size_t)n3, sizeof *rhs), *v0 = calloc((size_t)n3, sizeof *v0),
+           *v[3];
+    unsigned seed = 29;
+    for (int k = 0; k < n3; k++) {
+        rhs[k] = 1e-6 * frand(&seed);
+        v0[k] = 1e-3 * frand(&seed);
+    }
+    int split[3] = {2, 0, 3}, iterations[3];
+    for (int c = 0; c < 3; c++) {
+        v[c] = calloc((size_t)n3, sizeof *v[c]);
+        sim->shares.first[1] = split[c];
+        iterations[c] = cs_cg_solve(sim, v0, rhs, v[c], NULL, NULL, NULL);
+    }
+    assert_true(iterations[0] > 3);
+    for (int c = 1; c < 3; c++) {
+        assert_int_equal(iterations[c], iterations[0]);
+        assert_memory_equal(v[c], v[0], sizeof *v[0] * (size_t)n3);
+    }
+    for (int c = 0; c < 3; c++)
+        free(v[c]);
+    free(rhs), free(v0);
+    cs_sim_destroy(sim);
+    cs_trimesh_destroy(mesh);
+    omp_set_num_threads(threads_before);
+}
+
 static void check_phi(const cs_body_def *b, double t, double x, double y, double z,
                       double want_phi, const double *want_grad)
 {
@@ -386,6 +464,7 @@ int main(void)
         cmocka_unit_test(test_spring_force_is_minus_energy_gradient),
         cmocka_unit_test(test_damping_jacobian_matches_finite_differences),
         cmocka_unit_test(test_cg_matches_dense_solve),
+        cmocka_unit_test(test_thread_shares),
         cmocka_unit_test(test_analytic_bodies),
         cmocka_unit_test(test_gamma_regimes),
         cmocka_unit_test(test_keyframe_motion),
