@@ -150,17 +150,23 @@ static inline void precondition_row(const cs_sim *sim, int i, const double *ri, 
         *worst = res;
 }
 
-void cs_damping_apply(const cs_sim *sim, const double *v, double *out)
+void cs_damping_apply(cs_sim *sim, const double *v, double *out)
 {
     const int *own = cs_par_owned(sim->par);
-#pragma omp parallel for schedule(static)
-    for (int r = 0; r < sim->par->nowned; r++) {
-        int i = own[r];
-        double acc[3] = {out[3 * i], out[3 * i + 1], out[3 * i + 2]};
-        cs_springs_damping_row(&sim->springs, r, v, acc);
-        if (sim->wind_normal)
-            wind_row(sim, i, v, acc);
-        memcpy(out + 3 * i, acc, sizeof acc);
+#pragma omp parallel
+    {
+        double t0 = omp_get_wtime(); /* a pass over the springs like CG's: shared alike */
+        int r0, r1;
+        cs_shares_rows(&sim->shares, sim->par->nowned, &r0, &r1);
+        for (int r = r0; r < r1; r++) {
+            int i = own[r];
+            double acc[3] = {out[3 * i], out[3 * i + 1], out[3 * i + 2]};
+            cs_springs_damping_row(&sim->springs, r, v, acc);
+            if (sim->wind_normal)
+                wind_row(sim, i, v, acc);
+            memcpy(out + 3 * i, acc, sizeof acc);
+        }
+        cs_shares_clock(&sim->shares, t0);
     }
 }
 

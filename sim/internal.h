@@ -138,7 +138,7 @@ int cs_cg_solve(cs_sim *sim, const double *v0, const double *rhs, double *v, con
 /* out = (M - (dt/2) D) v, D the damping (and wind drag) velocity Jacobian. */
 void cs_system_apply(const cs_sim *sim, const double *v, double *out);
 /* out += D v (damping plus implicit wind drag). */
-void cs_damping_apply(const cs_sim *sim, const double *v, double *out);
+void cs_damping_apply(cs_sim *sim, const double *v, double *out);
 
 /* runaway.c: init after the step size and scripts are known; each step
  * begins with the bound at its end time, checks v after each stage that
