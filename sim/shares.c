@@ -3,7 +3,6 @@
 #include "sim/shares.h"
 
 #include <math.h>
-#include <stdbool.h>
 #include <stdlib.h>
 
 /* A measure moves a thread's speed this far towards itself: the split
@@ -49,8 +48,7 @@ void cs_shares_update(cs_shares *s)
         return;
     bool measured = true;
     for (int t = 0; t < s->threads; t++) {
-        int r0 = s->first[t] * s->block, r1 = s->first[t + 1] * s->block;
-        double rows = (r1 < s->nrows ? r1 : s->nrows) - (r0 < s->nrows ? r0 : s->nrows);
+        double rows = cs_shares_row(s, s->first[t + 1]) - cs_shares_row(s, s->first[t]);
         double busy = s->clock[t].busy, *speed = s->speed + t;
         s->clock[t].busy = 0;
         if (rows > 0 && busy > 0) {

@@ -7,8 +7,9 @@
  * took twice as long as the other over whole frames, the other waiting
  * 40% of its time in libgomp), or big and little cores. So the split
  * follows the threads' measured speeds: each thread clocks its own part
- * of the heavy passes (CG's, the springs'), and after each solve the
- * shares move towards rows in proportion to rows per second.
+ * of the heavy passes (CG's, the springs', B.5's damping pass), and after
+ * each solve the shares move towards rows in proportion to rows per
+ * second.
  *
  * Results do not depend on the split: every row's work is the same
  * wherever it runs, and sums are taken per block (CS_BLOCK rows) in block
@@ -18,6 +19,7 @@
 #define CS_SHARES_H
 
 #include <omp.h>
+#include <stdbool.h>
 
 /* one per thread, on its own cache line (the threads write them at once) */
 typedef struct cs_thread_clock {
@@ -38,18 +40,37 @@ typedef struct cs_shares {
 int cs_shares_init(cs_shares *s, int nrows, int block);
 void cs_shares_free(cs_shares *s);
 
-/* The calling thread's blocks [*b0, *b1); called inside a parallel
- * region. A team of another size than the split's (or no split) gets
- * equal shares. */
-static inline void cs_shares_blocks(const cs_shares *s, int nblocks, int *b0, int *b1)
+/* Whether s holds a split for the calling thread's team (inside a
+ * parallel region); a team of another size, or no split, gets equal
+ * shares. */
+static inline bool cs_shares_fit(const cs_shares *s)
+{
+    return s && s->first && s->threads == omp_get_num_threads();
+}
+
+/* The first row of block b (nrows for the blocks' end) */
+static inline int cs_shares_row(const cs_shares *s, int b)
+{
+    long r = (long)b * s->block;
+    return r < s->nrows ? (int)r : s->nrows;
+}
+
+/* The calling thread's equal share [*lo, *hi) of n items */
+static inline void cs_equal_share(int n, int *lo, int *hi)
 {
     int threads = omp_get_num_threads(), me = omp_get_thread_num();
-    if (s && s->first && s->threads == threads && s->nblocks == nblocks) {
-        *b0 = s->first[me];
-        *b1 = s->first[me + 1];
+    *lo = (int)((long)n * me / threads);
+    *hi = (int)((long)n * (me + 1) / threads);
+}
+
+/* The calling thread's blocks [*b0, *b1) of nblocks */
+static inline void cs_shares_blocks(const cs_shares *s, int nblocks, int *b0, int *b1)
+{
+    if (cs_shares_fit(s) && s->nblocks == nblocks) {
+        *b0 = s->first[omp_get_thread_num()];
+        *b1 = s->first[omp_get_thread_num() + 1];
     } else {
-        *b0 = (int)((long)nblocks * me / threads);
-        *b1 = (int)((long)nblocks * (me + 1) / threads);
+        cs_equal_share(nblocks, b0, b1);
     }
 }
 
@@ -61,24 +82,21 @@ static inline int cs_shares_bound(const cs_shares *s, int nblocks, int end)
     return b[end];
 }
 
-/* The calling thread's rows [*r0, *r1) of nrows: its blocks' rows, or
- * an equal share when the split is for another team or row count. */
+/* The calling thread's rows [*r0, *r1) of nrows: its blocks' rows */
 static inline void cs_shares_rows(const cs_shares *s, int nrows, int *r0, int *r1)
 {
-    int threads = omp_get_num_threads(), me = omp_get_thread_num();
-    if (s && s->first && s->threads == threads && s->nrows == nrows) {
-        *r0 = s->first[me] * s->block < nrows ? s->first[me] * s->block : nrows;
-        *r1 = s->first[me + 1] * s->block < nrows ? s->first[me + 1] * s->block : nrows;
+    if (cs_shares_fit(s) && s->nrows == nrows) {
+        *r0 = cs_shares_row(s, s->first[omp_get_thread_num()]);
+        *r1 = cs_shares_row(s, s->first[omp_get_thread_num() + 1]);
     } else {
-        *r0 = (int)((long)nrows * me / threads);
-        *r1 = (int)((long)nrows * (me + 1) / threads);
+        cs_equal_share(nrows, r0, r1);
     }
 }
 
 /* Charges the seconds since t0 (omp_get_wtime) to the calling thread. */
 static inline void cs_shares_clock(cs_shares *s, double t0)
 {
-    if (s && s->clock && s->threads == omp_get_num_threads())
+    if (cs_shares_fit(s))
         s->clock[omp_get_thread_num()].busy += omp_get_wtime() - t0;
 }
 
