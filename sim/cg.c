@@ -15,20 +15,11 @@
 
 static int block_count(const cs_par *par) { return (par->nowned + CS_BLOCK - 1) / CS_BLOCK; }
 
-/* acc += the implicit part of the linear normal drag on particle i */
-static inline void wind_row(const cs_sim *sim, int i, const double *v, double acc[3])
-{
-    const double *nrm = sim->wind_normal + 3 * i;
-    cs_axpy(-sim->def.wind.drag * sim->wind_area[i] * cs_dot(nrm, v + 3 * i), nrm, acc);
-}
-
 /* out_i = ((M - (dt/2) D) v)_i for row r (particle i) */
 static inline void system_row(const cs_sim *sim, int r, int i, const double *v, double out[3])
 {
     double acc[3] = {0, 0, 0};
-    cs_springs_damping_row(&sim->springs, r, v, acc);
-    if (sim->wind_normal)
-        wind_row(sim, i, v, acc);
+    cs_damping_row(sim, r, i, v, acc);
     for (int d = 0; d < 3; d++)
         out[d] = sim->mass[i] * v[3 * i + d] - sim->half_dt * acc[d];
 }
@@ -148,26 +139,6 @@ static inline void precondition_row(const cs_sim *sim, int i, const double *ri, 
     double res = cs_dot(ri, ri) * (inv_m * inv_m);
     if (res > *worst)
         *worst = res;
-}
-
-void cs_damping_apply(cs_sim *sim, const double *v, double *out)
-{
-    const int *own = cs_par_owned(sim->par);
-#pragma omp parallel
-    {
-        double t0 = omp_get_wtime(); /* a pass over the springs like CG's: shared alike */
-        int r0, r1;
-        cs_shares_rows(&sim->shares, sim->par->nowned, &r0, &r1);
-        for (int r = r0; r < r1; r++) {
-            int i = own[r];
-            double acc[3] = {out[3 * i], out[3 * i + 1], out[3 * i + 2]};
-            cs_springs_damping_row(&sim->springs, r, v, acc);
-            if (sim->wind_normal)
-                wind_row(sim, i, v, acc);
-            memcpy(out + 3 * i, acc, sizeof acc);
-        }
-        cs_shares_clock(&sim->shares, t0);
-    }
 }
 
 /* Owned entries of out; v must be current on the ghosts too. */
@@ -328,7 +299,7 @@ int cs_cg_solve(cs_sim *sim, const double *v0, const double *rhs, double *v, con
                 double acc[3] = {0, 0, 0}, B[6], *ri = w->r + 3 * i, *pi = w->p + 3 * i;
                 damping_row_and_block(s, r, w->y, acc, B);
                 if (sim->wind_normal) {
-                    wind_row(sim, i, w->y, acc);
+                    cs_wind_drag_row(sim, i, w->y, acc);
                     wind_block(sim, i, B);
                 }
                 double a[6];

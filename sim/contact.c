@@ -201,18 +201,29 @@ void cs_body_collide(cs_sim *sim, double dt)
 
 /* Step B.7: v_next holds v~^(n+1) (from v_NP for the improved method);
  * apply Gamma with the contact normal and the body's velocity at n+1. */
+/* B.7, with the runaway check of the particles it changes: the others'
+ * velocities were checked after B.6 (which leaves these to B.7) */
 void cs_body_friction(cs_sim *sim, double dt)
 {
-    CS_PARALLEL_FOR_OWNED(sim->par, i) { /* the poses of B.4, the same step's end */
-        int b = sim->contact_body[i];
-        if (b < 0)
-            continue;
-        double vb[3], out[3];
-        cs_body_posed_velocity(sim->body_pose + b, sim->x + 3 * i, vb);
-        cs_gamma(sim->v_next + 3 * i, sim->contact_normal + 3 * i, vb,
-                 step_friction(sim, sim->bodies + b, dt), out);
-        memcpy(sim->v_next + 3 * i, out, sizeof out);
+    double worst = 0;
+    int nan_seen = 0;
+    for (int r = 0; r < sim->par->nown; r++) {
+        int lo = sim->par->own[2 * r], hi = sim->par->own[2 * r + 1];
+#pragma omp parallel for schedule(static) reduction(max : worst) reduction(|| : nan_seen)
+        for (int i = lo; i < hi; i++) { /* the poses of B.4, the same step's end */
+            int b = sim->contact_body[i];
+            if (b < 0)
+                continue;
+            double vb[3], out[3];
+            cs_body_posed_velocity(sim->body_pose + b, sim->x + 3 * i, vb);
+            cs_gamma(sim->v_next + 3 * i, sim->contact_normal + 3 * i, vb,
+                     step_friction(sim, sim->bodies + b, dt), out);
+            memcpy(sim->v_next + 3 * i, out, sizeof out);
+            if (sim->is_free[i])
+                cs_speed_seen(out, &worst, &nan_seen);
+        }
     }
+    cs_runaway_note(sim, CS_STAGE_BODY_FRICTION, worst, nan_seen);
 }
 
 /* The deepest point of the cloth's surface inside a body (its true

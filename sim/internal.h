@@ -8,6 +8,7 @@
 #include "sim/selfcol.h"
 #include "sim/shares.h"
 #include "sim/springs.h"
+#include "sim/vec3.h"
 
 /* What the solver may change about a particle's velocity. */
 enum { CS_FIXED = 0, CS_FREE = 1, CS_CONTACT = 2 };
@@ -137,8 +138,22 @@ int cs_cg_solve(cs_sim *sim, const double *v0, const double *rhs, double *v, con
                 double *warm, double *warm_before);
 /* out = (M - (dt/2) D) v, D the damping (and wind drag) velocity Jacobian. */
 void cs_system_apply(const cs_sim *sim, const double *v, double *out);
-/* out += D v (damping plus implicit wind drag). */
-void cs_damping_apply(cs_sim *sim, const double *v, double *out);
+/* acc += the implicit part of the wind's linear normal drag on particle i */
+static inline void cs_wind_drag_row(const cs_sim *sim, int i, const double *v, double acc[3])
+{
+    const double *nrm = sim->wind_normal + 3 * i;
+    cs_axpy(-sim->def.wind.drag * sim->wind_area[i] * cs_dot(nrm, v + 3 * i), nrm, acc);
+}
+/* acc += (D v)_i for owned row r, particle i: its springs' damping, then
+ * the wind's drag. Inline, so that a pass over the rows does the rest of a
+ * particle's work with it. */
+static inline void cs_damping_row(const cs_sim *sim, int r, int i, const double *v,
+                                  double acc[3])
+{
+    cs_springs_damping_row(&sim->springs, r, v, acc);
+    if (sim->wind_normal)
+        cs_wind_drag_row(sim, i, v, acc);
+}
 
 /* runaway.c: init after the step size and scripts are known; each step
  * begins with the bound at its end time, checks v after each stage that
@@ -147,6 +162,19 @@ void cs_runaway_init(cs_sim *sim);
 double cs_runaway_limit(const cs_sim *sim, double t);
 void cs_runaway_begin_step(cs_sim *sim, double t1);
 void cs_runaway_check(cs_sim *sim, const double *v, cs_stage stage);
+/* The check folded into a stage's own pass over the particles it changed
+ * (the others were checked by an earlier stage and are unchanged): each
+ * particle's velocity through cs_speed_seen (worst and nan_seen reduced
+ * with max and ||), then one cs_runaway_note. */
+static inline void cs_speed_seen(const double vi[3], double *worst, int *nan_seen)
+{
+    double s2 = vi[0] * vi[0] + vi[1] * vi[1] + vi[2] * vi[2];
+    if (s2 != s2)
+        *nan_seen = 1;
+    else if (s2 > *worst)
+        *worst = s2;
+}
+void cs_runaway_note(cs_sim *sim, cs_stage stage, double worst, int nan_seen);
 bool cs_runaway_end_step(cs_sim *sim);
 
 /* step_limit.c: the stability limits at the rest state (stable_dt,
@@ -164,6 +192,7 @@ double cs_step_limit_now(cs_sim *sim);
 void cs_gamma(const double v[3], const double N[3], const double vb[3], double mu,
               double out[3]);
 void cs_body_collide(cs_sim *sim, double dt);
+/* B.7; checks the velocities it changes for a runaway */
 void cs_body_friction(cs_sim *sim, double dt);
 
 #endif

@@ -126,7 +126,7 @@ void cs_runaway_check(cs_sim *sim, const double *v, cs_stage stage)
 {
     /* threaded: the largest squared speed and whether any is NaN; a
      * maximum and an or are the same at every thread count */
-    double worst = 0, limit2 = sim->runaway.limit2;
+    double worst = 0;
     int nan_seen = 0;
     const unsigned char *is_free = sim->is_free, *mode = sim->mode;
     /* B.6's velocity at a particle in body contact is not a speed yet: with
@@ -140,18 +140,16 @@ void cs_runaway_check(cs_sim *sim, const double *v, cs_stage stage)
     for (int r = 0; r < sim->par->nown; r++) {
         int lo = sim->par->own[2 * r], hi = sim->par->own[2 * r + 1];
 #pragma omp parallel for schedule(static) reduction(max : worst) reduction(|| : nan_seen)
-        for (int i = lo; i < hi; i++) {
-            if (!is_free[i] || (after_b6 && mode[i] == CS_CONTACT))
-                continue;
-            const double *vi = v + 3 * i;
-            double s2 = vi[0] * vi[0] + vi[1] * vi[1] + vi[2] * vi[2];
-            if (s2 != s2)
-                nan_seen = 1;
-            else if (s2 > worst)
-                worst = s2;
-        }
+        for (int i = lo; i < hi; i++)
+            if (is_free[i] && !(after_b6 && mode[i] == CS_CONTACT))
+                cs_speed_seen(v + 3 * i, &worst, &nan_seen);
     }
-    if ((nan_seen || worst > limit2) && sim->runaway.stage < 0) {
+    cs_runaway_note(sim, stage, worst, nan_seen);
+}
+
+void cs_runaway_note(cs_sim *sim, cs_stage stage, double worst, int nan_seen)
+{
+    if ((nan_seen || worst > sim->runaway.limit2) && sim->runaway.stage < 0) {
         sim->runaway.stage = stage;
         sim->runaway.speed = nan_seen ? NAN : sqrt(worst);
     }

@@ -778,13 +778,14 @@ void cs_selfcol_find_pairs(cs_sim *sim, double span)
  * particles' state brought from the owners and the new velocities sent
  * back); phase II, every rank its internal pairs. The result is that of
  * one serial Gauss-Seidel order. */
-void cs_selfcol_repulse(cs_sim *sim, double *x, double *v, double dt, bool elastic)
+long cs_selfcol_repulse(cs_sim *sim, double *x, double *v, double dt, bool elastic)
 {
     cs_selfcol *sc = sim->selfcol;
     cs_par *par = sim->par;
     const cs_self_collision_def *d = &sim->def.self;
     response r = {true, elastic, !elastic, dt, d->thickness, d->stiffness, d->friction,
                   d->edge_flip_epsilon};
+    long before = sc->stats.repulsions;
     if (par->size > 1) {
         cs_halo_forward(par, &sc->bhalo, x, 3);
         cs_halo_forward(par, &sc->bhalo, v, 3);
@@ -792,4 +793,5 @@ void cs_selfcol_repulse(cs_sim *sim, double *x, double *v, double dt, bool elast
         cs_halo_reverse(par, &sc->bhalo, v, 3);
     }
     sc->stats.repulsions += cs_pairs_apply(sc, &sc->pt, &sc->ee, x, v, &r);
+    return sc->stats.repulsions - before;
 }

@@ -125,8 +125,9 @@ void cs_selfcol_find_pairs(cs_sim *sim, double span);
 
 /* B.2 (elastic true): inelastic then elastic repulsion on v~^(n+1/2) with
  * positions x^n. B.8 (elastic false): inelastic repulsion and friction on
- * v^(n+1) with positions x^(n+1). */
-void cs_selfcol_repulse(cs_sim *sim, double *x, double *v, double dt, bool elastic);
+ * v^(n+1) with positions x^(n+1). Returns how many pairs were near
+ * enough to act (0: v unchanged here). */
+long cs_selfcol_repulse(cs_sim *sim, double *x, double *v, double dt, bool elastic);
 
 /* Step C over the span since the last collision-free state, k time steps
  * of it. Updates x, v and the collision-free state. With detect_only,

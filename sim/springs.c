@@ -336,13 +336,17 @@ static row_arrays row_arrays_of(cs_springs *s)
                         s->row_direction, s->row_magnitude};
 }
 
-static void add_row_force(const cs_springs *s, int r, const cs_pair2 fr[3], double *f)
+/* Stored, not added: a lane sum is never -0 (the lanes start at +0, and
+ * in rounding to nearest only -0 + -0 gives -0), so 0 + sum, the old
+ * zeroing pass and an add, gave the same bits; the pass and its fork cost
+ * more. */
+static void store_row_force(const cs_springs *s, int r, const cs_pair2 fr[3], double *f)
 {
     if (!f)
         return;
     int i = s->row_particle[r];
     for (int d = 0; d < 3; d++)
-        f[3 * i + d] += fr[d][0] + fr[d][1];
+        f[3 * i + d] = fr[d][0] + fr[d][1];
 }
 
 /* The elastic pass with a wide kernel takes its rows in batches of at
@@ -402,7 +406,7 @@ prepare_rows_batched(cs_springs *s, const double *x, double *f, bool keep_magnit
                 inv_lengths(b.uu, b.inv, e1 - e0);
                 batch_finish(a, e0, e1, &b, 0, keep_magnitude, fr);
             }
-            add_row_force(s, r, fr, f);
+            store_row_force(s, r, fr, f);
             r++;
             continue;
         }
@@ -412,7 +416,7 @@ prepare_rows_batched(cs_springs *s, const double *x, double *f, bool keep_magnit
         for (int q = r; q < rb; q++) {
             cs_pair2 fr[3] = {{0, 0}, {0, 0}, {0, 0}};
             batch_finish(a, start[q], start[q + 1], &b, start[q] - start[r], keep_magnitude, fr);
-            add_row_force(s, q, fr, f);
+            store_row_force(s, q, fr, f);
         }
         r = rb;
     }
@@ -433,7 +437,7 @@ prepare_rows_pairs(cs_springs *s, const double *x, double *f, bool keep_magnitud
             cs_pair2 inv = inv_length_pair(u[0] * u[0] + u[1] * u[1] + u[2] * u[2]);
             finish_pair(a, e, u, inv, keep_magnitude, fr);
         }
-        add_row_force(s, r, fr, f);
+        store_row_force(s, r, fr, f);
     }
 }
 
@@ -480,7 +484,7 @@ prepare_rows(cs_springs *s, const double *x, double *f, bool keep_magnitude)
  * (a quarter of the pass's stores). */
 void cs_springs_prepare(cs_springs *s, const double *x) { prepare_rows(s, x, NULL, true); }
 
-void cs_springs_add_elastic(cs_springs *s, const double *x, double *f)
+void cs_springs_elastic(cs_springs *s, const double *x, double *f)
 {
     prepare_rows(s, x, f, false);
 }

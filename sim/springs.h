@@ -126,10 +126,11 @@ int cs_springs_index(cs_springs *s, int nrows, const int *particles, int npartic
 /* Stores sqrt(d) u_hat and the elastic magnitude of every spring at positions x,
  * for the damping operator and cs_springs_step_bound. */
 void cs_springs_prepare(cs_springs *s, const double *x);
-/* Elastic forces only (the explicit part) at positions x, added into f;
+/* Elastic forces only (the explicit part) at positions x, stored into f
+ * at the rows' particles (the others untouched);
  * stores the directions at x as cs_springs_prepare does (one pass over the
  * springs serves both), but not the magnitudes. */
-void cs_springs_add_elastic(cs_springs *s, const double *x, double *f);
+void cs_springs_elastic(cs_springs *s, const double *x, double *f);
 /* out += D v, the damping force (D is the velocity Jacobian, symmetric
  * negative semi-definite), with the directions from cs_springs_prepare. */
 void cs_springs_add_damping(const cs_springs *s, const double *v, double *out);

@@ -1,6 +1,7 @@
 /* step.c: the time step of Section 3 as a table of stages, the outer
  * collision loop of Section 4 around it, and a frame of outer steps. */
 #include <math.h>
+#include <omp.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -143,9 +144,10 @@ double cs_wind_max_speed(const cs_wind_def *w)
  * (the ghosts' forces are zero); one threaded pass after the springs' */
 static void explicit_forces(cs_sim *sim, const double *x, const double *v_start, double t)
 {
-    CS_PARALLEL_FOR_LOCAL(sim->par, i)
-        sim->force[3 * i] = sim->force[3 * i + 1] = sim->force[3 * i + 2] = 0;
-    cs_springs_add_elastic(&sim->springs, x, sim->force);
+    if (cs_par_distributed(sim->par)) /* the ghosts' stay zero */
+        CS_PARALLEL_FOR_LOCAL(sim->par, i)
+            sim->force[3 * i] = sim->force[3 * i + 1] = sim->force[3 * i + 2] = 0;
+    cs_springs_elastic(&sim->springs, x, sim->force); /* the owned rows' */
     double c = sim->def.wind.drag;
     CS_PARALLEL_FOR_OWNED(sim->par, i) {
         double *f = sim->force + 3 * i;
@@ -189,6 +191,14 @@ static void release_separating(cs_sim *sim, int i, const double *v_p)
         return;
     for (int d = 0; d < 3; d++)
         sim->v_next[3 * i + d] = 2.0 * v_p[3 * i + d] - sim->v_star[3 * i + d];
+}
+
+/* Scripted (and pinned) particles end the step at their script's velocity */
+static void hold_scripted(cs_sim *sim)
+{
+    CS_FOR_OWNED(sim->par, i)
+        if (!sim->is_free[i])
+            memcpy(sim->v_next + 3 * i, sim->script_v + 3 * i, 3 * sizeof(double));
 }
 
 /* ------------------------------------------------------------ the step
@@ -235,11 +245,18 @@ static const double *stage_velocity_half(cs_sim *sim, const step_state *st)
     return sim->v_half;
 }
 
+/* What B.2 or B.8 leaves to check: v, unless no pair was near on this
+ * rank (then no velocity changed; with ranks, another's impulses may
+ * arrive through the halo) */
+static const double *repulsed(const cs_sim *sim, long near, const double *v)
+{
+    return near > 0 || sim->par->size > 1 ? v : NULL;
+}
+
 /* B.2: repulsions change only the velocity that moves the positions */
 static const double *stage_self_repulsion(cs_sim *sim, const step_state *st)
 {
-    cs_selfcol_repulse(sim, sim->x, sim->v_half, st->dt, true);
-    return sim->v_half;
+    return repulsed(sim, cs_selfcol_repulse(sim, sim->x, sim->v_half, st->dt, true), sim->v_half);
 }
 
 /* B.3; without bodies, v*^n is v^n */
@@ -288,46 +305,66 @@ static const double *stage_velocity_full(cs_sim *sim, const step_state *st)
     sim->cg_iterations += cs_cg_solve(sim, sim->v_star, sim->rhs, v_p, sim->cg.warm_half,
                                       sim->cg.warm_full_less_half,
                                       sim->cg.warm_full_less_half_before);
-    if (st->bodies && sim->def.friction_method == CS_FRICTION_IMPROVED) {
-        copy_ranges(par->local, par->nlocal, sim->v_next, sim->force);
-        cs_halo_forward(par, &par->ghosts, v_p, 3);
-        cs_damping_apply(sim, v_p, sim->v_next); /* F_i + F_d v_P */
-        CS_PARALLEL_FOR_OWNED(par, i) {
-            for (int d = 0; d < 3; d++) {
-                int k = 3 * i + d;
-                double v_np = sim->v_star[k] + sim->half_dt / sim->mass[i] * sim->v_next[k];
-                sim->v_next[k] = 2.0 * v_np - sim->v_star[k];
-            }
-            release_separating(sim, i, v_p);
-        }
-    } else {
+    if (!(st->bodies && sim->def.friction_method == CS_FRICTION_IMPROVED)) {
         CS_PARALLEL_FOR_OWNED(par, i)
             for (int d = 0; d < 3; d++)
                 sim->v_next[3 * i + d] = 2.0 * v_p[3 * i + d] - sim->v_star[3 * i + d];
+        hold_scripted(sim);
+        return sim->v_next;
     }
-    CS_FOR_OWNED(par, i)
-        if (!sim->is_free[i])
-            memcpy(sim->v_next + 3 * i, sim->script_v + 3 * i, 3 * sizeof(double));
-    return sim->v_next;
+    /* One pass over the rows: F_i + F_d v_P, B.6 from it, and the runaway
+     * check (a copy of the forces, the damping pass, B.6 and the check
+     * were four passes, each with a fork; the same bits). The rows are
+     * shared among the threads as CG's are (shares.h). */
+    cs_halo_forward(par, &par->ghosts, v_p, 3);
+    const int *own = cs_par_owned(par);
+    double worst = 0;
+    int nan_seen = 0;
+#pragma omp parallel reduction(max : worst) reduction(|| : nan_seen)
+    {
+        double t0 = omp_get_wtime();
+        int r0, r1;
+        cs_shares_rows(&sim->shares, par->nowned, &r0, &r1);
+        for (int r = r0; r < r1; r++) {
+            int i = own[r];
+            double f[3];
+            memcpy(f, sim->force + 3 * i, sizeof f);
+            cs_damping_row(sim, r, i, v_p, f);
+            for (int d = 0; d < 3; d++) {
+                int k = 3 * i + d;
+                double v_np = sim->v_star[k] + sim->half_dt / sim->mass[i] * f[d];
+                sim->v_next[k] = 2.0 * v_np - sim->v_star[k];
+            }
+            release_separating(sim, i, v_p);
+            /* B.6's velocity in contact is not a speed yet: B.7's check */
+            if (sim->is_free[i] && sim->mode[i] != CS_CONTACT)
+                cs_speed_seen(sim->v_next + 3 * i, &worst, &nan_seen);
+        }
+        cs_shares_clock(&sim->shares, t0);
+    }
+    cs_runaway_note(sim, CS_STAGE_VELOCITY_FULL, worst, nan_seen);
+    hold_scripted(sim);
+    return NULL; /* checked */
 }
 
 /* B.7 */
 static const double *stage_body_friction(cs_sim *sim, const step_state *st)
 {
     cs_body_friction(sim, st->dt);
-    return sim->v_next;
+    return NULL; /* checked */
 }
 
 /* B.8: inelastic repulsion and friction on the final velocity */
 static const double *stage_self_friction(cs_sim *sim, const step_state *st)
 {
-    cs_selfcol_repulse(sim, sim->x, sim->v_next, st->dt, false);
-    return sim->v_next;
+    return repulsed(sim, cs_selfcol_repulse(sim, sim->x, sim->v_next, st->dt, false), sim->v_next);
 }
 
 static const struct {
     cs_stage stage;
-    stage_fn run; /* returns the velocity it made, for the runaway check */
+    /* returns the velocity it made, for the runaway check; NULL where it
+     * changed none or checked its own */
+    stage_fn run;
 } STEP_STAGES[] = {
     {CS_STAGE_SCRIPTED_VERTICES, stage_scripted_vertices},
     {CS_STAGE_WIND, stage_wind},

@@ -43,7 +43,7 @@ static void test_spring_force_is_minus_energy_gradient(void **state)
     for (int k = 0; k < 3 * sim->n; k++) /* deform: stretch some, squash others */
         sim->x[k] += 0.02 * frand(&seed);
     double *f = calloc(3 * (size_t)sim->n, sizeof *f);
-    cs_springs_add_elastic(&sim->springs, sim->x, f);
+    cs_springs_elastic(&sim->springs, sim->x, f);
     double eps = 1e-7, worst = 0, scale = 0;
     for (int k = 0; k < 3 * sim->n; k++) {
         double keep = sim->x[k];
@@ -67,7 +67,7 @@ static void test_spring_force_is_minus_energy_gradient(void **state)
 static void spring_force(cs_sim *sim, const double *v, double *f)
 {
     memset(f, 0, sizeof *f * 3 * (size_t)sim->n);
-    cs_springs_add_elastic(&sim->springs, sim->x, f);
+    cs_springs_elastic(&sim->springs, sim->x, f);
     cs_springs_prepare(&sim->springs, sim->x);
     cs_springs_add_damping(&sim->springs, v, f);
 }
