@@ -322,8 +322,10 @@ finish_pair(row_arrays a, int e, const cs_pair2 u[3], cs_pair2 inv, bool keep_ma
                                   (cs_pair2_load(a.inv_rest_length + e) - inv),
                               inv != 0);
     cs_pair2 scale = inv * cs_pair2_load(a.sqrt_damping + e);
-    cs_pair2 w[3] = {u[0] * scale, u[1] * scale, u[2] * scale};
-    memcpy(a.direction + 3 * e, w, sizeof w);
+    for (int d = 0; d < 3; d++) { /* a store each: one of the array went through the stack */
+        cs_pair2 w = u[d] * scale;
+        memcpy(a.direction + 3 * e + 2 * d, &w, sizeof w);
+    }
     if (keep_magnitude) /* a loop invariant: the compiler unswitches it */
         memcpy(a.magnitude + e, &mag, sizeof mag);
     for (int d = 0; d < 3; d++)
@@ -365,16 +367,18 @@ typedef struct length_batch {
 } length_batch;
 
 /* entries [e0, e1) of row r (at most BATCH, e0 even) into b from entry
- * off: u and |u|^2 */
+ * off (even): u and |u|^2 (pointers stepped, not indices halved: the
+ * signed halving cost four instructions a pair) */
 static inline __attribute__((always_inline)) void
 batch_gather(const cs_springs *s, const double *x, int r, int e0, int e1, length_batch *b, int off)
 {
     const double *xi = x + 3 * s->row_particle[r];
-    for (int e = e0, k = off; e < e1; e += 2, k += 2) {
-        cs_pair2 *u = b->u[k / 2];
-        cs_pair2_gather(x, s->row_other, e, xi, u);
-        cs_pair2 uu = u[0] * u[0] + u[1] * u[1] + u[2] * u[2];
-        memcpy(b->uu + k, &uu, sizeof uu);
+    cs_pair2(*u)[3] = b->u + off / 2;
+    double *uu = b->uu + off;
+    for (int e = e0; e < e1; e += 2, u++, uu += 2) {
+        cs_pair2_gather(x, s->row_other, e, xi, *u);
+        cs_pair2 sq = (*u)[0] * (*u)[0] + (*u)[1] * (*u)[1] + (*u)[2] * (*u)[2];
+        memcpy(uu, &sq, sizeof sq);
     }
 }
 
@@ -382,8 +386,10 @@ static inline __attribute__((always_inline)) void
 batch_finish(row_arrays a, int e0, int e1, const length_batch *b, int off, bool keep_magnitude,
              cs_pair2 f[3])
 {
-    for (int e = e0, k = off; e < e1; e += 2, k += 2)
-        finish_pair(a, e, b->u[k / 2], cs_pair2_load(b->inv + k), keep_magnitude, f);
+    const cs_pair2(*u)[3] = b->u + off / 2;
+    const double *inv = b->inv + off;
+    for (int e = e0; e < e1; e += 2, u++, inv += 2)
+        finish_pair(a, e, *u, cs_pair2_load(inv), keep_magnitude, f);
 }
 
 /* rows [r, r_end) in batches through the wide kernel */
