@@ -145,7 +145,8 @@ static int next_body(const cs_body_grid *g, const int *unbounded, int nunbounded
 
 /* Step B.4: sim->x holds x~^(n+1) on entry and x^(n+1) on return; x_prev
  * is x^n, v_half is v~^(n+1/2). Sets v_star = Gamma(v^n) for particles in
- * contact (v^n elsewhere) and marks them CS_CONTACT with their normal.
+ * contact (v^n elsewhere) and marks them CS_CONTACT with their normal;
+ * checks v_star for a runaway.
  *
  * Each free point meets its bodies in ascending order, each seeing the
  * position the previous ones left: the unbounded bodies (planes) and the
@@ -167,14 +168,20 @@ void cs_body_collide(cs_sim *sim, double dt)
         if (!g.ok || !g.bounded[b]) /* no grid (no memory): every body is asked */
             unbounded[nunbounded++] = b;
     long contacts = 0;
+    double worst = 0; /* the runaway check of v_star, in the same pass */
+    int nan_seen = 0;
     for (int r = 0; r < sim->par->nown; r++) {
         int i0 = sim->par->own[2 * r], i1 = sim->par->own[2 * r + 1];
-#pragma omp parallel for schedule(static) reduction(+ : contacts)
+#pragma omp parallel for schedule(static) reduction(+ : contacts) reduction(max : worst) \
+    reduction(|| : nan_seen)
         for (int i = i0; i < i1; i++) {
             memcpy(sim->v_star + 3 * i, sim->v + 3 * i, 3 * sizeof(double));
             sim->contact_body[i] = -1;
-            if (!sim->active[i])
+            if (!sim->active[i]) {
+                if (sim->is_free[i])
+                    cs_speed_seen(sim->v_star + 3 * i, &worst, &nan_seen);
                 continue;
+            }
             const double *x = sim->x + 3 * i;
             int first, last;
             cs_body_grid_cell_bodies(&g, x, &first, &last);
@@ -192,8 +199,11 @@ void cs_body_collide(cs_sim *sim, double dt)
                 sim->mode[i] = CS_CONTACT;
                 contacts++;
             }
+            if (sim->is_free[i])
+                cs_speed_seen(sim->v_star + 3 * i, &worst, &nan_seen);
         }
     }
+    cs_runaway_note(sim, CS_STAGE_BODY_COLLISION, worst, nan_seen);
     sim->contacts += contacts;
     free(unbounded);
     cs_body_grid_free(&g);

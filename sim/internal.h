@@ -175,7 +175,10 @@ static inline void cs_speed_seen(const double vi[3], double *worst, int *nan_see
         *worst = s2;
 }
 void cs_runaway_note(cs_sim *sim, cs_stage stage, double worst, int nan_seen);
-bool cs_runaway_end_step(cs_sim *sim);
+/* not_finite: whether any owned x or v is (cs_runaway_not_finite, or the
+ * caller's own pass over them) */
+bool cs_runaway_end_step(cs_sim *sim, int not_finite);
+int cs_runaway_not_finite(const cs_sim *sim);
 
 /* step_limit.c: the stability limits at the rest state (stable_dt,
  * damped_dt, undamped_dt, gershgorin_dt), and the damped limit at the
@@ -191,6 +194,7 @@ double cs_step_limit_now(cs_sim *sim);
 /* contact.c: Section 6. */
 void cs_gamma(const double v[3], const double N[3], const double vb[3], double mu,
               double out[3]);
+/* B.4; checks the velocities it makes for a runaway */
 void cs_body_collide(cs_sim *sim, double dt);
 /* B.7; checks the velocities it changes for a runaway */
 void cs_body_friction(cs_sim *sim, double dt);

@@ -155,15 +155,8 @@ void cs_runaway_note(cs_sim *sim, cs_stage stage, double worst, int nan_seen)
     }
 }
 
-bool cs_runaway_end_step(cs_sim *sim)
+int cs_runaway_not_finite(const cs_sim *sim)
 {
-    /* one reduction: the earliest stage (as STAGE_COUNT - stage, so the
-     * maximum wins), the speed seen there, and NaN anywhere in x or v */
-    double verdict[2] = {0, 0};
-    if (sim->runaway.stage >= 0) {
-        verdict[0] = CS_STAGE_COUNT - sim->runaway.stage;
-        verdict[1] = isnan(sim->runaway.speed) ? INFINITY : sim->runaway.speed;
-    }
     int not_finite = 0;
     const double *x = sim->x, *v = sim->v;
     for (int r = 0; r < sim->par->nown; r++) {
@@ -172,6 +165,18 @@ bool cs_runaway_end_step(cs_sim *sim)
         for (int k = lo; k < hi; k++)
             if (!isfinite(x[k]) || !isfinite(v[k]))
                 not_finite = 1;
+    }
+    return not_finite;
+}
+
+bool cs_runaway_end_step(cs_sim *sim, int not_finite)
+{
+    /* one reduction: the earliest stage (as STAGE_COUNT - stage, so the
+     * maximum wins), the speed seen there, and NaN anywhere in x or v */
+    double verdict[2] = {0, 0};
+    if (sim->runaway.stage >= 0) {
+        verdict[0] = CS_STAGE_COUNT - sim->runaway.stage;
+        verdict[1] = isnan(sim->runaway.speed) ? INFINITY : sim->runaway.speed;
     }
     if (not_finite) {
         if (verdict[0] == 0)

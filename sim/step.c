@@ -279,7 +279,7 @@ static const double *stage_position_update(cs_sim *sim, const step_state *st)
 static const double *stage_body_collision(cs_sim *sim, const step_state *st)
 {
     cs_body_collide(sim, st->dt);
-    return sim->v_star;
+    return NULL; /* checked */
 }
 
 /* B.5 and B.6: v^(n+1/2) = v*^n + dt/2 a(x^(n+1/2), v^(n+1/2)) with the
@@ -386,11 +386,13 @@ int cs_sim_step(cs_sim *sim, double dt)
     if (fabs(st.t1 - sim->frame_end) <= 1e-9 * dt)
         st.t1 = sim->frame_end; /* the frame's last step lands on its end */
     sim->half_dt = 0.5 * dt;
-    /* x (owned and ghosts) is current here; v only where owned */
-    copy_ranges(par->local, par->nlocal, sim->x_prev, sim->x);
+    /* x (owned and ghosts) is current here; v only where owned. One pass
+     * keeps x^n and resets the modes (the ghosts' are never read). */
     release_scripts(sim, dt);
-    CS_PARALLEL_FOR_OWNED(par, i)
+    CS_PARALLEL_FOR_LOCAL(par, i) {
+        memcpy(sim->x_prev + 3 * i, sim->x + 3 * i, 3 * sizeof(double));
         sim->mode[i] = sim->is_free[i] ? CS_FREE : CS_FIXED;
+    }
     cs_runaway_begin_step(sim, st.t1);
     for (size_t k = 0; k < sizeof STEP_STAGES / sizeof STEP_STAGES[0]; k++) {
         cs_stage stage = STEP_STAGES[k].stage;
@@ -402,9 +404,18 @@ int cs_sim_step(cs_sim *sim, double dt)
             cs_runaway_check(sim, v, stage);
         STAGE_END(sim, stage);
     }
-    copy_ranges(par->own, par->nown, sim->v, sim->v_next);
+    int not_finite = 0; /* v^(n+1) taken, and x and v checked, in one pass */
+    for (int r = 0; r < par->nown; r++) {
+        int lo = 3 * par->own[2 * r], hi = 3 * par->own[2 * r + 1];
+#pragma omp parallel for schedule(static) reduction(|| : not_finite)
+        for (int k = lo; k < hi; k++) {
+            sim->v[k] = sim->v_next[k];
+            if (!isfinite(sim->x[k]) || !isfinite(sim->v[k]))
+                not_finite = 1;
+        }
+    }
     sim->t = st.t1;
-    return cs_runaway_end_step(sim) ? CS_OK : CS_ERR_UNSTABLE;
+    return cs_runaway_end_step(sim, not_finite) ? CS_OK : CS_ERR_UNSTABLE;
 }
 
 /* One outer collision step of k time steps (Section 4): step A, k steps of
@@ -457,7 +468,7 @@ static int outer_step(cs_sim *sim, int k)
         cs_selfcol_collide(sim, sim->t - t0, k, false);
         cs_runaway_check(sim, sim->v, CS_STAGE_COLLISIONS);
         STAGE_END(sim, CS_STAGE_COLLISIONS);
-        return cs_runaway_end_step(sim) ? CS_OK : CS_ERR_UNSTABLE;
+        return cs_runaway_end_step(sim, cs_runaway_not_finite(sim)) ? CS_OK : CS_ERR_UNSTABLE;
     }
 }
 
