@@ -755,14 +755,16 @@ void cs_selfcol_find_pairs(cs_sim *sim, double span)
     finder f = {sim, sc, thickness, span};
     for (int t = 0; t < sc->nmade; t++) /* threads added by the searches start at 0 */
         sc->made[t].nearest = INFINITY;
-    int failed = sc_cache_update(sc, sim->par->rank, thickness) ||
-                 sc_find_pairs(sc, false, false, make_repulsion_point_triangle, &f, &sc->pt) ||
-                 sc_find_pairs(sc, true, false, make_repulsion_edge_edge, &f, &sc->ee);
     /* start_gap: the makers measured every pair of this rank whose boxes
-     * overlap; the others' boxes, each at least half the thickness around
-     * its particles, lie apart, so their sides are a thickness apart (less
-     * a thousandth for the boxes' round-off) */
+     * overlap but those the skin showed farther than this; the others'
+     * boxes, each at least half the thickness around its particles, lie
+     * apart, so their sides are a thickness apart (less a thousandth for
+     * the boxes' round-off) */
     double gap = 0.999 * thickness;
+    sc_skin skin = {thickness, span, gap}, *use = sc->cache.skin_off ? NULL : &skin;
+    int failed = sc_cache_update(sc, sim->par->rank, thickness, sim->v, mean) ||
+                 sc_find_pairs(sc, false, false, use, make_repulsion_point_triangle, &f, &sc->pt) ||
+                 sc_find_pairs(sc, true, false, use, make_repulsion_edge_edge, &f, &sc->ee);
     for (int t = 0; t < sc->nmade; t++)
         if (!(sc->made[t].nearest >= gap))
             gap = sc->made[t].nearest;

@@ -69,6 +69,16 @@ typedef struct cs_pair_cache {
                                     centroid over step A's span, from the
                                     last step A (selfcol_cache.c's forecast) */
     int served;                  /* searches since it was built */
+    /* The distance skin (step A): x_free when it was built, and per cached
+     * pair the distance between its sides there (NaN until measured); per
+     * particle, at the present search, how far it moved since the build
+     * with the centroid's motion taken out, and its speed relative to the
+     * cloth's mean velocity (selfcol_cache.c) */
+    double *x_ref, *pt_ref, *ee_ref;
+    int pt_ref_cap, ee_ref_cap;
+    double *moved, *speed;
+    bool skin_off;               /* tests: step A measures every pair */
+    long skin_skips;             /* pairs the skin spared the makers, in all */
 } cs_pair_cache;
 
 typedef struct cs_selfcol {

@@ -21,16 +21,26 @@ int sc_pair_push(cs_pair_list *l, const int v[4], const double *s0);
 int sc_distribute_boundary(cs_sim *sim, cs_pair_list *pt, cs_pair_list *ee);
 /* Before steps A and C search with the boxes in sc->pbox, ebox and tbox
  * (around x_free): makes the cache hold every pair whose boxes can overlap,
- * traversing the trees only when a particle's box left its grown box.
- * Returns 0 or -1 (no memory). */
-int sc_cache_update(cs_selfcol *sc, int rank, double thickness);
+ * traversing the trees only when a particle's box left its grown box;
+ * with v (step A: the velocities, mean their mean), measures the skin's
+ * motion for this search. Returns 0 or -1 (no memory). */
+int sc_cache_update(cs_selfcol *sc, int rank, double thickness, const double *v,
+                    const double mean[3]);
 int sc_cache_create(cs_selfcol *sc);
 void sc_cache_free(cs_selfcol *sc);
+/* What step A's makers keep and measure: a pair closer than
+ * thickness + (relative speed) span, and distances under gap_cap
+ * (start_gap's). With it, sc_find_pairs skips the pairs the skin shows
+ * to be farther than both (selfcol_cache.c). */
+typedef struct sc_skin {
+    double thickness, span, gap_cap;
+} sc_skin;
 /* The cached point/triangle (edges: edge/edge) pairs whose present boxes
- * overlap (only_dirty: with a dirty side) and that make accepts, appended
- * to list in (a, b) order at any thread count. Returns 0 or -1. */
-int sc_find_pairs(cs_selfcol *sc, bool edges, bool only_dirty, pair_maker make, const void *ctx,
-                  cs_pair_list *list);
+ * overlap (only_dirty: with a dirty side), that skin (NULL: none) does not
+ * show to be far, and that make accepts, appended to list in (a, b) order
+ * at any thread count. Returns 0 or -1. */
+int sc_find_pairs(cs_selfcol *sc, bool edges, bool only_dirty, const sc_skin *skin,
+                  pair_maker make, const void *ctx, cs_pair_list *list);
 void sc_pair_impulse(const cs_selfcol *sc, const cs_pair *p, const double c[4], double J,
                      const double dir[3], double *v);
 double sc_pair_inverse_mass(const cs_selfcol *sc, const cs_pair *p, const double c[4]);
