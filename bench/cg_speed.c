@@ -95,7 +95,7 @@ int main(int argc, char **argv)
             cs_springs_elastic(&sim->springs, sim->x, force);
         elastic = fmin(elastic, (cs_now() - t0) / calls);
         t0 = cs_now();
-        iterations = cs_cg_solve(sim, v0, rhs, sol, NULL, NULL, NULL);
+        iterations = cs_cg_solve(sim, v0, rhs, sol, NULL, NULL, NULL, -1);
         solve = fmin(solve, cs_now() - t0);
     }
     long entries = sim->springs.row_start[sim->springs.nrows];

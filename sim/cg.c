@@ -227,7 +227,7 @@ static const double WARM_BEFORE_WEIGHT = 0.75;
  * particles of |r_i| / m_i: a maximum is exact, so every rank and thread
  * count stops at the same iteration. */
 int cs_cg_solve(cs_sim *sim, const double *v0, const double *rhs, double *v, const double *base,
-                double *warm, double *warm_before)
+                double *warm, double *warm_before, int check_stage)
 {
     cs_par *par = sim->par;
     cs_cg_work *w = &sim->cg;
@@ -376,23 +376,43 @@ int cs_cg_solve(cs_sim *sim, const double *v0, const double *rhs, double *v, con
             rho = rho_next;
             it++;
         }
-        FOR_MY_BLOCKS(sim, t0, b, r0, r1)
-        for (int r = r0; r < r1; r++)
-            for (int d = 0; d < 3; d++) {
-                int k = 3 * own[r] + d;
-                /* only a pending step is added: z + 0 p would turn a -0 into
-                 * +0 (or a non-finite p into NaN) and change the bits */
-                double z = pending != 0 ? w->z[k] + pending * w->p[k] : w->z[k];
-                v[k] = v0[k] + z;
-                if (warm) {
-                    warm_before[k] = warm[k];
-                    warm[k] = z - w->explicit_z[k] - (base ? base[k] : 0.0);
+        FOR_MY_BLOCKS(sim, t0, b, r0, r1) {
+            double worst = 0;
+            int nan_seen = 0;
+            for (int r = r0; r < r1; r++) {
+                int i = own[r];
+                for (int d = 0; d < 3; d++) {
+                    int k = 3 * i + d;
+                    /* only a pending step is added: z + 0 p would turn a -0
+                     * into +0 (or a non-finite p into NaN) and change the bits */
+                    double z = pending != 0 ? w->z[k] + pending * w->p[k] : w->z[k];
+                    v[k] = v0[k] + z;
+                    if (warm) {
+                        warm_before[k] = warm[k];
+                        warm[k] = z - w->explicit_z[k] - (base ? base[k] : 0.0);
+                    }
                 }
+                if (check_stage >= 0 && sim->is_free[i])
+                    cs_speed_seen(v + 3 * i, &worst, &nan_seen);
             }
+            /* op_sum is free: every thread read it before the last update
+             * pass's barrier (-1: a NaN seen) */
+            op_sum[b] = nan_seen ? -1 : worst;
+        }
         cs_shares_clock(&sim->shares, t0); /* the region's end is the barrier */
 #pragma omp master
         iterations = it;
     }
     cs_shares_update(&sim->shares);
+    if (check_stage >= 0) {
+        double worst = 0;
+        int nan_seen = 0;
+        for (int b = 0; b < nb; b++)
+            if (op_sum[b] < 0)
+                nan_seen = 1;
+            else
+                worst = fmax(worst, op_sum[b]);
+        cs_runaway_note(sim, (cs_stage)check_stage, worst, nan_seen);
+    }
     return iterations;
 }

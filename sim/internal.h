@@ -132,10 +132,12 @@ int cs_sort_unique_pairs(int *pairs, int n);
  * warm and warm_before (3 per particle each, or both NULL) hold the
  * damping responses of the last two solves of the same kind, less base's
  * (NULL: zero), and base plus their blend is added to the start; they
- * shift by one, warm receiving this one's response less base.
+ * shift by one, warm receiving this one's response less base. With
+ * check_stage >= 0, v is that stage's velocity and the last pass checks it
+ * for a runaway (cs_runaway_check's work, folded in).
  * Returns the iteration count, the same on every rank. */
 int cs_cg_solve(cs_sim *sim, const double *v0, const double *rhs, double *v, const double *base,
-                double *warm, double *warm_before);
+                double *warm, double *warm_before, int check_stage);
 /* out = (M - (dt/2) D) v, D the damping (and wind drag) velocity Jacobian. */
 void cs_system_apply(const cs_sim *sim, const double *v, double *out);
 /* acc += the implicit part of the wind's linear normal drag on particle i */

@@ -228,21 +228,35 @@ static const double *stage_wind(cs_sim *sim, const step_state *st)
     return NULL;
 }
 
+/* Whether any owned particle is pinned or scripted (a serial scan of
+ * bytes costs less than a threaded copy of velocities) */
+static bool any_held(const cs_sim *sim)
+{
+    CS_FOR_OWNED(sim->par, i)
+        if (!sim->is_free[i])
+            return true;
+    return false;
+}
+
 /* B.1: v~^(n+1/2) = v^n + dt/2 a(x^n, v~^(n+1/2)), unconstrained by
  * contact (constraining it would make cloth stick to bodies). Scripted
  * particles move straight to their targets. */
 static const double *stage_velocity_half(cs_sim *sim, const step_state *st)
 {
     cs_par *par = sim->par;
-    copy_ranges(par->own, par->nown, sim->v0, sim->v);
-    CS_FOR_OWNED(par, i)
-        if (!sim->is_free[i])
-            for (int d = 0; d < 3; d++)
-                sim->v0[3 * i + d] = (sim->script_x[3 * i + d] - sim->x[3 * i + d]) / st->dt;
+    const double *v0 = sim->v; /* the start: v^n, where nothing is held */
+    if (any_held(sim)) {
+        copy_ranges(par->own, par->nown, sim->v0, sim->v);
+        CS_FOR_OWNED(par, i)
+            if (!sim->is_free[i])
+                for (int d = 0; d < 3; d++)
+                    sim->v0[3 * i + d] = (sim->script_x[3 * i + d] - sim->x[3 * i + d]) / st->dt;
+        v0 = sim->v0;
+    }
     explicit_forces(sim, sim->x, sim->v, sim->t); /* prepares the springs' directions at x^n too */
-    sim->cg_iterations += cs_cg_solve(sim, sim->v0, sim->rhs, sim->v_half, NULL,
-                                      sim->cg.warm_half, sim->cg.warm_half_before);
-    return sim->v_half;
+    sim->cg_iterations += cs_cg_solve(sim, v0, sim->rhs, sim->v_half, NULL, sim->cg.warm_half,
+                                      sim->cg.warm_half_before, CS_STAGE_VELOCITY_HALF);
+    return NULL; /* checked */
 }
 
 /* What B.2 or B.8 leaves to check: v, unless no pair was near on this
@@ -304,7 +318,7 @@ static const double *stage_velocity_full(cs_sim *sim, const step_state *st)
      * springs, half a step later) plus how B.5's exceeded B.1's lately */
     sim->cg_iterations += cs_cg_solve(sim, sim->v_star, sim->rhs, v_p, sim->cg.warm_half,
                                       sim->cg.warm_full_less_half,
-                                      sim->cg.warm_full_less_half_before);
+                                      sim->cg.warm_full_less_half_before, -1);
     if (!(st->bodies && sim->def.friction_method == CS_FRICTION_IMPROVED)) {
         CS_PARALLEL_FOR_OWNED(par, i)
             for (int d = 0; d < 3; d++)

@@ -178,7 +178,7 @@ static void test_cg_matches_dense_solve(void **state)
         rhs[k] = 1e-6 * frand(&seed);
         ref[k] = rhs[k];
     }
-    int it = cs_cg_solve(sim, v0, rhs, v, NULL, NULL, NULL);
+    int it = cs_cg_solve(sim, v0, rhs, v, NULL, NULL, NULL, -1);
     assert_true(it > 3); /* the damping couples particles: real work */
     dense_solve(n3, A, ref);
     double worst = 0, scale = 0;
@@ -202,7 +202,7 @@ static void test_cg_matches_dense_solve(void **state)
     }
     double *old = malloc(sizeof *old * (size_t)n3);
     memcpy(old, warm, sizeof *old * (size_t)n3);
-    assert_int_equal(cs_cg_solve(sim, v0, rhs, v, base, warm, before), 0);
+    assert_int_equal(cs_cg_solve(sim, v0, rhs, v, base, warm, before, -1), 0);
     for (int k = 0; k < n3; k++) {
         double response = ref[k] - rhs[k] / sim->mass[k / 3];
         assert_true(fabs(v[k] - ref[k]) < 1e-9 * scale);
@@ -211,7 +211,7 @@ static void test_cg_matches_dense_solve(void **state)
         warm[k] = before[k] = 0;
         base[k] = 1e-4 * frand(&seed); /* a hundred times the answer's size */
     }
-    assert_true(cs_cg_solve(sim, v0, rhs, v, base, warm, before) > 3);
+    assert_true(cs_cg_solve(sim, v0, rhs, v, base, warm, before, -1) > 3);
     for (int k = 0; k < n3; k++)
         assert_true(fabs(v[k] - ref[k]) < 1e-9 * scale);
     free(base), free(warm), free(before), free(old);
@@ -232,7 +232,7 @@ static void test_cg_matches_dense_solve(void **state)
     sim->mode[1] = CS_FIXED;
     for (int k = 0; k < n3; k++)
         v0[k] = 0.1 * frand(&seed);
-    cs_cg_solve(sim, v0, rhs, v, NULL, NULL, NULL);
+    cs_cg_solve(sim, v0, rhs, v, NULL, NULL, NULL, -1);
     cs_system_apply(sim, v, col);
     for (int i = 0; i < sim->n; i++) {
         double r[3], dv[3];
@@ -321,7 +321,7 @@ static void test_thread_shares(void **state)
     for (int c = 0; c < 3; c++) {
         v[c] = calloc((size_t)n3, sizeof *v[c]);
         sim->shares.first[1] = split[c];
-        iterations[c] = cs_cg_solve(sim, v0, rhs, v[c], NULL, NULL, NULL);
+        iterations[c] = cs_cg_solve(sim, v0, rhs, v[c], NULL, NULL, NULL, -1);
     }
     assert_true(iterations[0] > 3);
     for (int c = 1; c < 3; c++) {
