@@ -143,8 +143,9 @@ static void skin_measure(cs_selfcol *sc, const double *v, const double mean[3],
         for (int k = 0; k < 3; k++)
             d[k] = sc->x_free[3 * i + k] - c->x_ref[3 * i + k] - T[k];
         cs_sub(v + 3 * i, mean, u);
-        c->moved[i] = cs_norm(d);
-        c->speed[i] = cs_norm(u);
+        double m = cs_norm(d), sp = cs_norm(u);
+        c->moved[i] = m == m ? m : INFINITY; /* NaN: never far (skin_far's maxima) */
+        c->speed[i] = sp == sp ? sp : INFINITY;
     }
 }
 
@@ -171,13 +172,15 @@ static bool skin_far(cs_selfcol *sc, bool edges, int k, int a, int b, const sc_s
                      : cs_point_triangle_closest(x + 3 * v[0], x + 3 * v[1], x + 3 * v[2],
                                                  x + 3 * v[3], w);
     }
-    double moved[2] = {0, 0}, speed[2] = {0, 0};
+    double moved[2] = {0, 0}, speed[2] = {0, 0}; /* (comparisons: fmax is a call) */
     for (int i = 0; i < 4; i++) {
         int side = i >= split;
-        moved[side] = fmax(moved[side], c->moved[v[i]]);
-        speed[side] = fmax(speed[side], c->speed[v[i]]);
+        double m = c->moved[v[i]], sp = c->speed[v[i]];
+        moved[side] = m > moved[side] ? m : moved[side];
+        speed[side] = sp > speed[side] ? sp : speed[side];
     }
-    double keep = fmax(skin->gap_cap, skin->thickness + (speed[0] + speed[1]) * skin->span);
+    double keep = skin->thickness + (speed[0] + speed[1]) * skin->span;
+    keep = keep > skin->gap_cap ? keep : skin->gap_cap;
     return *ref - (moved[0] + moved[1]) >= keep + SKIN_MARGIN_PER_THICKNESS * skin->thickness;
 }
 
