@@ -170,18 +170,11 @@ void cs_body_collide(cs_sim *sim, double dt)
     long contacts = 0;
     double worst = 0; /* the runaway check of v_star, in the same pass */
     int nan_seen = 0;
-    for (int r = 0; r < sim->par->nown; r++) {
-        int i0 = sim->par->own[2 * r], i1 = sim->par->own[2 * r + 1];
-#pragma omp parallel for schedule(static) reduction(+ : contacts) reduction(max : worst) \
-    reduction(|| : nan_seen)
-        for (int i = i0; i < i1; i++) {
-            memcpy(sim->v_star + 3 * i, sim->v + 3 * i, 3 * sizeof(double));
-            sim->contact_body[i] = -1;
-            if (!sim->active[i]) {
-                if (sim->is_free[i])
-                    cs_speed_seen(sim->v_star + 3 * i, &worst, &nan_seen);
-                continue;
-            }
+    CS_PARALLEL_FOR_OWNED_WITH(sim->par, i, reduction(+ : contacts) reduction(max : worst)
+                                                 reduction(|| : nan_seen)) {
+        memcpy(sim->v_star + 3 * i, sim->v + 3 * i, 3 * sizeof(double));
+        sim->contact_body[i] = -1;
+        if (sim->active[i]) {
             const double *x = sim->x + 3 * i;
             int first, last;
             cs_body_grid_cell_bodies(&g, x, &first, &last);
@@ -199,9 +192,9 @@ void cs_body_collide(cs_sim *sim, double dt)
                 sim->mode[i] = CS_CONTACT;
                 contacts++;
             }
-            if (sim->is_free[i])
-                cs_speed_seen(sim->v_star + 3 * i, &worst, &nan_seen);
         }
+        if (sim->is_free[i])
+            cs_speed_seen(sim->v_star + 3 * i, &worst, &nan_seen);
     }
     cs_runaway_note(sim, CS_STAGE_BODY_COLLISION, worst, nan_seen);
     sim->contacts += contacts;
@@ -210,28 +203,24 @@ void cs_body_collide(cs_sim *sim, double dt)
 }
 
 /* Step B.7: v_next holds v~^(n+1) (from v_NP for the improved method);
- * apply Gamma with the contact normal and the body's velocity at n+1. */
-/* B.7, with the runaway check of the particles it changes: the others'
- * velocities were checked after B.6 (which leaves these to B.7) */
+ * apply Gamma with the contact normal and the body's velocity at n+1, and
+ * check the velocities it changes for a runaway (the others were checked
+ * after B.6, which leaves these to B.7). */
 void cs_body_friction(cs_sim *sim, double dt)
 {
     double worst = 0;
     int nan_seen = 0;
-    for (int r = 0; r < sim->par->nown; r++) {
-        int lo = sim->par->own[2 * r], hi = sim->par->own[2 * r + 1];
-#pragma omp parallel for schedule(static) reduction(max : worst) reduction(|| : nan_seen)
-        for (int i = lo; i < hi; i++) { /* the poses of B.4, the same step's end */
-            int b = sim->contact_body[i];
-            if (b < 0)
-                continue;
-            double vb[3], out[3];
-            cs_body_posed_velocity(sim->body_pose + b, sim->x + 3 * i, vb);
-            cs_gamma(sim->v_next + 3 * i, sim->contact_normal + 3 * i, vb,
-                     step_friction(sim, sim->bodies + b, dt), out);
-            memcpy(sim->v_next + 3 * i, out, sizeof out);
-            if (sim->is_free[i])
-                cs_speed_seen(out, &worst, &nan_seen);
-        }
+    CS_PARALLEL_FOR_OWNED_WITH(sim->par, i, reduction(max : worst) reduction(|| : nan_seen)) {
+        int b = sim->contact_body[i]; /* the poses of B.4, the same step's end */
+        if (b < 0)
+            continue;
+        double vb[3], out[3];
+        cs_body_posed_velocity(sim->body_pose + b, sim->x + 3 * i, vb);
+        cs_gamma(sim->v_next + 3 * i, sim->contact_normal + 3 * i, vb,
+                 step_friction(sim, sim->bodies + b, dt), out);
+        memcpy(sim->v_next + 3 * i, out, sizeof out);
+        if (sim->is_free[i])
+            cs_speed_seen(out, &worst, &nan_seen);
     }
     cs_runaway_note(sim, CS_STAGE_BODY_FRICTION, worst, nan_seen);
 }

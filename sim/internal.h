@@ -177,10 +177,11 @@ static inline void cs_speed_seen(const double vi[3], double *worst, int *nan_see
         *worst = s2;
 }
 void cs_runaway_note(cs_sim *sim, cs_stage stage, double worst, int nan_seen);
-/* not_finite: whether any owned x or v is (cs_runaway_not_finite, or the
- * caller's own pass over them) */
+/* not_finite: cs_runaway_not_finite's answer */
 bool cs_runaway_end_step(cs_sim *sim, int not_finite);
-int cs_runaway_not_finite(const cs_sim *sim);
+/* Whether any owned x or v is not finite; with v_next, v takes it first,
+ * in the same pass (the step's end) */
+int cs_runaway_not_finite(cs_sim *sim, const double *v_next);
 
 /* step_limit.c: the stability limits at the rest state (stable_dt,
  * damped_dt, undamped_dt, gershgorin_dt), and the damped limit at the

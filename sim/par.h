@@ -70,6 +70,12 @@ typedef struct cs_par {
         for (int i = (ranges)[2 * r_##i]; i < (ranges)[2 * r_##i + 1]; i++)
 #define CS_PARALLEL_FOR_OWNED(par, i) CS_PARALLEL_FOR_RANGES((par)->own, (par)->nown, i)
 #define CS_PARALLEL_FOR_LOCAL(par, i) CS_PARALLEL_FOR_RANGES((par)->local, (par)->nlocal, i)
+/* The owned loop with OpenMP clauses, e.g. reduction(max : worst) */
+#define CS_OMP_PRAGMA(text) _Pragma(#text)
+#define CS_PARALLEL_FOR_OWNED_WITH(par, i, clauses)                                \
+    for (int r_##i = 0; r_##i < (par)->nown; r_##i++)                              \
+        CS_OMP_PRAGMA(omp parallel for schedule(static) clauses)                   \
+        for (int i = (par)->own[2 * r_##i]; i < (par)->own[2 * r_##i + 1]; i++)
 
 /* Partitions n particles at positions x by recursive median split over
  * the ranks of comm; springs (2 ends each) decide the ghosts. Returns NULL

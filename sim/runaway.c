@@ -137,13 +137,9 @@ void cs_runaway_check(cs_sim *sim, const double *v, cs_stage stage)
      * (the 200 x 200 bench, frame 24), so those particles are checked after
      * B.7, in body_friction's check. */
     bool after_b6 = stage == CS_STAGE_VELOCITY_FULL;
-    for (int r = 0; r < sim->par->nown; r++) {
-        int lo = sim->par->own[2 * r], hi = sim->par->own[2 * r + 1];
-#pragma omp parallel for schedule(static) reduction(max : worst) reduction(|| : nan_seen)
-        for (int i = lo; i < hi; i++)
-            if (is_free[i] && !(after_b6 && mode[i] == CS_CONTACT))
-                cs_speed_seen(v + 3 * i, &worst, &nan_seen);
-    }
+    CS_PARALLEL_FOR_OWNED_WITH(sim->par, i, reduction(max : worst) reduction(|| : nan_seen))
+        if (is_free[i] && !(after_b6 && mode[i] == CS_CONTACT))
+            cs_speed_seen(v + 3 * i, &worst, &nan_seen);
     cs_runaway_note(sim, stage, worst, nan_seen);
 }
 
@@ -155,17 +151,17 @@ void cs_runaway_note(cs_sim *sim, cs_stage stage, double worst, int nan_seen)
     }
 }
 
-int cs_runaway_not_finite(const cs_sim *sim)
+int cs_runaway_not_finite(cs_sim *sim, const double *v_next)
 {
     int not_finite = 0;
-    const double *x = sim->x, *v = sim->v;
-    for (int r = 0; r < sim->par->nown; r++) {
-        int lo = 3 * sim->par->own[2 * r], hi = 3 * sim->par->own[2 * r + 1];
-#pragma omp parallel for schedule(static) reduction(|| : not_finite)
-        for (int k = lo; k < hi; k++)
+    double *x = sim->x, *v = sim->v;
+    CS_PARALLEL_FOR_OWNED_WITH(sim->par, i, reduction(|| : not_finite))
+        for (int k = 3 * i; k < 3 * i + 3; k++) {
+            if (v_next)
+                v[k] = v_next[k];
             if (!isfinite(x[k]) || !isfinite(v[k]))
                 not_finite = 1;
-    }
+        }
     return not_finite;
 }
 

@@ -418,16 +418,7 @@ int cs_sim_step(cs_sim *sim, double dt)
             cs_runaway_check(sim, v, stage);
         STAGE_END(sim, stage);
     }
-    int not_finite = 0; /* v^(n+1) taken, and x and v checked, in one pass */
-    for (int r = 0; r < par->nown; r++) {
-        int lo = 3 * par->own[2 * r], hi = 3 * par->own[2 * r + 1];
-#pragma omp parallel for schedule(static) reduction(|| : not_finite)
-        for (int k = lo; k < hi; k++) {
-            sim->v[k] = sim->v_next[k];
-            if (!isfinite(sim->x[k]) || !isfinite(sim->v[k]))
-                not_finite = 1;
-        }
-    }
+    int not_finite = cs_runaway_not_finite(sim, sim->v_next); /* v^(n+1) taken too */
     sim->t = st.t1;
     return cs_runaway_end_step(sim, not_finite) ? CS_OK : CS_ERR_UNSTABLE;
 }
@@ -482,7 +473,7 @@ static int outer_step(cs_sim *sim, int k)
         cs_selfcol_collide(sim, sim->t - t0, k, false);
         cs_runaway_check(sim, sim->v, CS_STAGE_COLLISIONS);
         STAGE_END(sim, CS_STAGE_COLLISIONS);
-        return cs_runaway_end_step(sim, cs_runaway_not_finite(sim)) ? CS_OK : CS_ERR_UNSTABLE;
+        return cs_runaway_end_step(sim, cs_runaway_not_finite(sim, NULL)) ? CS_OK : CS_ERR_UNSTABLE;
     }
 }
 
