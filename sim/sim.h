@@ -172,6 +172,7 @@ double cs_body_def_phi(const cs_body_def *b, double t, const double x[3], double
  * each body about every point near it), computed once. */
 typedef struct cs_body_pose {
     double R[9], c[3], velocity[3], omega[3];
+    bool unrotated; /* R is exactly the identity: queries skip the products */
 } cs_body_pose;
 void cs_body_def_pose(const cs_body_def *b, double t, cs_body_pose *pose);
 /* cs_body_def_phi and cs_body_def_velocity at a pose: the same numbers */
