@@ -63,19 +63,19 @@ typedef struct cs_par {
 #define CS_FOR_OWNED(par, i) CS_FOR_RANGES((par)->own, (par)->nown, i)
 #define CS_FOR_LOCAL(par, i) CS_FOR_RANGES((par)->local, (par)->nlocal, i)
 /* The same loops shared among the OpenMP threads, each range in fixed
- * contiguous shares: for per-particle work with no reduction. */
-#define CS_PARALLEL_FOR_RANGES(ranges, nranges, i)                                 \
+ * contiguous shares; clauses are OpenMP's, e.g. reduction(max : worst),
+ * or none for per-particle work with no reduction. */
+#define CS_OMP_PRAGMA(text) _Pragma(#text)
+#define CS_PARALLEL_FOR_RANGES_WITH(ranges, nranges, i, clauses)                   \
     for (int r_##i = 0; r_##i < (nranges); r_##i++)                                \
-        _Pragma("omp parallel for schedule(static)")                               \
+        CS_OMP_PRAGMA(omp parallel for schedule(static) clauses)                   \
         for (int i = (ranges)[2 * r_##i]; i < (ranges)[2 * r_##i + 1]; i++)
+#define CS_PARALLEL_FOR_RANGES(ranges, nranges, i)                                 \
+    CS_PARALLEL_FOR_RANGES_WITH(ranges, nranges, i, )
 #define CS_PARALLEL_FOR_OWNED(par, i) CS_PARALLEL_FOR_RANGES((par)->own, (par)->nown, i)
 #define CS_PARALLEL_FOR_LOCAL(par, i) CS_PARALLEL_FOR_RANGES((par)->local, (par)->nlocal, i)
-/* The owned loop with OpenMP clauses, e.g. reduction(max : worst) */
-#define CS_OMP_PRAGMA(text) _Pragma(#text)
 #define CS_PARALLEL_FOR_OWNED_WITH(par, i, clauses)                                \
-    for (int r_##i = 0; r_##i < (par)->nown; r_##i++)                              \
-        CS_OMP_PRAGMA(omp parallel for schedule(static) clauses)                   \
-        for (int i = (par)->own[2 * r_##i]; i < (par)->own[2 * r_##i + 1]; i++)
+    CS_PARALLEL_FOR_RANGES_WITH((par)->own, (par)->nown, i, clauses)
 
 /* Partitions n particles at positions x by recursive median split over
  * the ranks of comm; springs (2 ends each) decide the ghosts. Returns NULL
