@@ -110,6 +110,10 @@ struct cs_sim {
     double damped_dt;             /* the damped scheme's limit at rest (step_limit.c) */
     double undamped_dt;           /* 2 / omega_max, omega_max^2 by Lanczos */
     double gershgorin_dt;         /* the same from Gershgorin's bound (smaller) */
+    /* the damped limit's bisection (step_limit.c): the rows still in
+     * question (-1: all) and each one's bound at the last step tried */
+    int *bound_rows, nbound_rows, bound_capacity;
+    double *bound_value;
     cs_par *par;                  /* ownership, ghosts, messages (Section 7) */
     unsigned char *active;        /* free and owned here: bodies act on these */
     cs_stage_timing timing[CS_STAGE_COUNT];

@@ -471,6 +471,8 @@ void cs_sim_destroy(cs_sim *sim)
         free(arrays[k]);
     free(sim->is_free);
     free(sim->mode);
+    free(sim->bound_rows);
+    free(sim->bound_value);
     free(sim->script_of);
     free(sim->script_lag);
     free(sim->script_lag_start);

@@ -545,21 +545,28 @@ double cs_springs_rest_step_bound(const cs_springs *s, const double *mass,
 }
 
 double cs_springs_step_bound(const cs_springs *s, const double *mass,
-                             const unsigned char *is_free, double dt)
+                             const unsigned char *is_free, double dt, const int *rows, int n,
+                             double *value)
 {
+    if (!rows)
+        n = s->nrows;
     double bound = 0; /* a maximum: the same at any thread count */
 #pragma omp parallel for schedule(static) reduction(max : bound)
-    for (int r = 0; r < s->nrows; r++) {
-        int i = s->row_particle[r];
-        if (!is_free[i])
-            continue;
-        double sum = 0;
-        for (int e = s->row_start[r]; e < s->row_start[r + 1]; e++)
-            sum += cs_spring_step_term(dt, s->row_stiffness[e] * s->row_inv_rest_length[e],
-                                       s->row_sqrt_damping[e] * s->row_sqrt_damping[e],
-                                       s->row_magnitude[e]);
-        if (2.0 * sum / mass[i] > bound)
-            bound = 2.0 * sum / mass[i];
+    for (int k = 0; k < n; k++) {
+        int r = rows ? rows[k] : k, i = s->row_particle[r];
+        double row_bound = 0;
+        if (is_free[i]) {
+            double sum = 0;
+            for (int e = s->row_start[r]; e < s->row_start[r + 1]; e++)
+                sum += cs_spring_step_term(dt, s->row_stiffness[e] * s->row_inv_rest_length[e],
+                                           s->row_sqrt_damping[e] * s->row_sqrt_damping[e],
+                                           s->row_magnitude[e]);
+            row_bound = 2.0 * sum / mass[i];
+        }
+        if (value)
+            value[k] = row_bound;
+        if (row_bound > bound)
+            bound = row_bound;
     }
     return bound;
 }

@@ -165,8 +165,15 @@ static inline double cs_spring_step_term(double dt, double k, double c, double g
 double cs_springs_rest_step_bound(const cs_springs *s, const double *mass,
                                   const unsigned char *is_free, int nparticles, double dt);
 /* The same over the rows (cs_springs_index) at the positions last given to
- * cs_springs_prepare, tension included. */
+ * cs_springs_prepare, tension included: over rows[0..n) (row indices), or
+ * every row when rows is NULL; with value, each listed row's own bound
+ * goes to value[k] (0 for a particle that is not free). A row's bound
+ * never decreases as dt grows: each term is 0 or a product of non-negative
+ * factors that grow with dt, and rounding keeps that order, so a row that
+ * passes at one dt passes at every smaller one (step_limit.c's bisection
+ * drops such rows). */
 double cs_springs_step_bound(const cs_springs *s, const double *mass,
-                             const unsigned char *is_free, double dt);
+                             const unsigned char *is_free, double dt, const int *rows, int n,
+                             double *value);
 
 #endif

@@ -36,6 +36,7 @@
  * step limit").
  */
 #include <math.h>
+#include <stdlib.h>
 
 #include "sim/internal.h"
 #include "sim/par.h"
@@ -46,6 +47,8 @@ enum { LANCZOS_STEPS = 60 };
 /* bisections in log dt between brackets at most a frame apart: 2^-24 of
  * the ratio leaves the step within 1e-6 of the largest that passes */
 enum { STEP_BISECTIONS = 24 };
+/* a step is stable when the bound is at most this */
+static const double STABLE_BOUND = 4;
 
 typedef double (*step_bound_fn)(cs_sim *sim, double dt);
 
@@ -54,23 +57,41 @@ static double rest_bound(cs_sim *sim, double dt)
     return cs_springs_rest_step_bound(&sim->springs, sim->mass, sim->is_free, sim->n, dt);
 }
 
+/* The current positions' bound over the rows still in question
+ * (sim->bound_rows, or every row while nbound_rows < 0). A failing dt
+ * becomes the bisection's upper end, and a row that passes there passes
+ * at every step still to be tried (springs.h), so only the rows that
+ * failed stay in question: the bisection answers the same at every test,
+ * and its later tests read a few rows instead of all of them (26 passes
+ * over the springs an outer step before). */
 static double current_bound(cs_sim *sim, double dt)
 {
-    double bound = cs_springs_step_bound(&sim->springs, sim->mass, sim->is_free, dt);
+    const cs_springs *s = &sim->springs;
+    bool listed = sim->nbound_rows >= 0;
+    double bound = cs_springs_step_bound(s, sim->mass, sim->is_free, dt,
+                                         listed ? sim->bound_rows : NULL, sim->nbound_rows,
+                                         sim->bound_value);
     cs_par_max(sim->par, &bound, 1);
+    if (bound > STABLE_BOUND && sim->bound_value) { /* dt fails: keep the rows above */
+        int n = listed ? sim->nbound_rows : s->nrows, kept = 0;
+        for (int k = 0; k < n; k++)
+            if (sim->bound_value[k] > STABLE_BOUND)
+                sim->bound_rows[kept++] = listed ? sim->bound_rows[k] : k;
+        sim->nbound_rows = kept;
+    }
     return bound;
 }
 
 /* The largest dt in [lo, hi] whose bound is at most 4; 0 when lo fails. */
 static double largest_step(cs_sim *sim, step_bound_fn bound, double lo, double hi)
 {
-    if (!(lo > 0) || !(bound(sim, lo) <= 4))
+    if (!(lo > 0) || !(bound(sim, lo) <= STABLE_BOUND))
         return 0;
-    if (bound(sim, hi) <= 4)
+    if (bound(sim, hi) <= STABLE_BOUND)
         return hi;
     for (int it = 0; it < STEP_BISECTIONS; it++) {
         double mid = sqrt(lo * hi);
-        if (bound(sim, mid) <= 4)
+        if (bound(sim, mid) <= STABLE_BOUND)
             lo = mid;
         else
             hi = mid;
@@ -104,6 +125,21 @@ double cs_step_limit_now(cs_sim *sim)
     if (!isfinite(sim->gershgorin_dt))
         return INFINITY; /* no springs */
     cs_springs_prepare(&sim->springs, sim->x); /* the tension at x */
+    int nrows = sim->springs.nrows;
+    if (sim->bound_capacity < nrows) { /* without the lists, every test reads every row */
+        free(sim->bound_rows);
+        free(sim->bound_value);
+        sim->bound_rows = malloc(sizeof *sim->bound_rows * (size_t)nrows);
+        sim->bound_value = malloc(sizeof *sim->bound_value * (size_t)nrows);
+        sim->bound_capacity = sim->bound_rows && sim->bound_value ? nrows : 0;
+        if (!sim->bound_capacity) {
+            free(sim->bound_rows);
+            free(sim->bound_value);
+            sim->bound_rows = NULL;
+            sim->bound_value = NULL;
+        }
+    }
+    sim->nbound_rows = -1; /* every row in question */
     double frame = 1.0 / sim->def.fps;
     double damped = largest_step(sim, current_bound, fmin(sim->gershgorin_dt, frame), frame);
     return fmax(sim->undamped_dt, damped);
