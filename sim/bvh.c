@@ -291,9 +291,15 @@ int cs_bvh_collect(const cs_bvh *A, const cs_bvh *B, int rank, cs_bvh_work *w,
     int failed = 0;
 #pragma omp parallel for schedule(dynamic, 1) reduction(| : failed)
     for (int t = 0; t < w->ntasks; t++) {
-        traversal tr = {A, B, A == B, rank, 0, NULL, w->found + t, 0};
-        tr.out->n = 0;
+        /* the task's list filled in a copy on this thread's stack: the
+         * tasks' lists lie side by side, four to a cache line, and two
+         * threads pushing onto neighbours passed that line back and forth
+         * at every pair (a quarter of the traversal's samples) */
+        cs_index_pairs found = w->found[t];
+        found.n = 0;
+        traversal tr = {A, B, A == B, rank, 0, NULL, &found, 0};
         descend(&tr, w->task[2 * t], w->task[2 * t + 1], 0);
+        w->found[t] = found;
         failed |= tr.failed;
     }
     long total = 0;

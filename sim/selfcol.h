@@ -55,6 +55,10 @@ typedef struct cs_made_list {
     int n, capacity;
     cs_made_pair *m;
     double nearest; /* the least distance the thread's makers measured */
+    /* one list per thread, side by side, written at every pair made and
+     * distance measured: 64 bytes each, so that no two threads' counters
+     * share a cache line */
+    char pad[64 - 2 * sizeof(int) - sizeof(cs_made_pair *) - sizeof(double)];
 } cs_made_list;
 
 /* Candidate pairs kept between searches (selfcol_cache.c). */
