@@ -314,12 +314,18 @@ static int write_frame(run_state *r, int frame, char *err, size_t errlen)
     return rc;
 }
 
+/* The summary's wall time and stage table brought up to now */
+static void take_totals(run_state *r)
+{
+    r->summary.total_seconds = r->summary.base_seconds + cs_now() - r->start;
+    cs_summary_take_timing(&r->summary, r->sim);
+}
+
 /* While the status is "running" summary.json leaves the frame records to
  * frames.jsonl (a constant cost per frame); once it is final, whole. */
 static int write_summary(run_state *r, char *err, size_t errlen)
 {
-    r->summary.total_seconds = r->summary.base_seconds + cs_now() - r->start;
-    cs_summary_take_timing(&r->summary, r->sim);
+    take_totals(r);
     bool final = strcmp(r->summary.status, "running") != 0;
     r->summary_at = cs_now();
     return cs_summary_write(&r->summary, r->summary_path, final, err, errlen);
@@ -329,6 +335,10 @@ static int write_summary(run_state *r, char *err, size_t errlen)
  * from (cs_sim_state_gather came first, on every rank). */
 static int save_state(run_state *r, int frame, const char *hash, char *err, size_t errlen)
 {
+    /* the totals a resumed run carries on from are those of this frame
+     * (the summary is written at most once a second, so its totals could
+     * lag frames behind, and a resumed run's stage table lost them) */
+    take_totals(r);
     double t0 = cs_now();
     int rc = cs_outdir_save_state(&r->out, &r->id, frame, hash, r->sim, &r->summary, err,
                                   errlen);

@@ -338,6 +338,8 @@ int cs_summary_add_frame(cs_summary *s, const cs_frame_record *frame, char *err,
     }
     s->records_size += (long)len + 1;
     s->nframes++;
+    s->run_frames++;
+    s->run_steps += frame->stats.steps;
     return 0;
 }
 
@@ -432,12 +434,22 @@ void cs_summary_print_table(const cs_summary *s, FILE *out)
     int simulated = s->nframes;
     fprintf(out, "\nwall time %.3f s (simulation %.3f s, output %.3f s)\n",
             s->total_seconds, s->simulation_seconds, s->output_seconds);
-    if (simulated > 0)
-        fprintf(out, "simulation time per frame %.3f s over %d frame%s (%d steps of %.3g s each)\n",
-                s->simulation_seconds / simulated, simulated, simulated == 1 ? "" : "s",
-                s->steps_per_frame, s->dt);
-    else
+    if (simulated > 0) {
+        fprintf(out, "simulation time per frame %.3f s over %d frame%s",
+                s->simulation_seconds / simulated, simulated, simulated == 1 ? "" : "s");
+        if (s->run_steps != (long)s->steps_per_frame * s->run_frames)
+            /* the damped limit chose the step before every outer step */
+            fprintf(out, " (%.1f steps a frame over the %d this command simulated, each step "
+                    "chosen from the cloth's tension; %d of %.3g s at rest)\n",
+                    (double)s->run_steps / s->run_frames, s->run_frames, s->steps_per_frame,
+                    s->dt);
+        else if (s->run_frames > 0)
+            fprintf(out, " (%d steps of %.3g s each)\n", s->steps_per_frame, s->dt);
+        else
+            fprintf(out, " (none simulated by this command)\n");
+    } else {
         fprintf(out, "no frame simulated\n");
+    }
 }
 
 /* ------------------------------------------------------------ reading */

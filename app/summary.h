@@ -81,6 +81,8 @@ typedef struct cs_summary {
     char initial_hash[CS_STATE_HASH_LEN]; /* frame 0's state */
     int resumed_from;                /* the frame this command resumed from, else -1 */
     int nframes;                     /* records in frames.jsonl (frames 1..nframes) */
+    int run_frames;                  /* of which simulated by this command, */
+    long run_steps;                  /* in this many steps */
     /* frames.jsonl: open for appending, and its length after the last
      * whole record */
     const char *records_path;

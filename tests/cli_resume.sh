@@ -33,6 +33,10 @@ for s, d in ((sa, a), (sb, b)):
     assert [f["frame"] for f in s["frames"]] == list(range(1, n + 1)), (d, len(s["frames"]))
     recs = [json.loads(l) for l in open(d + "/frames.jsonl")]
     assert [r["state_hash"] for r in recs] == [f["state_hash"] for f in s["frames"]], d
+    # the stage table counts every frame's steps, a resumed run's too
+    calls = {x["name"]: x["calls"] for x in s["stages"]}
+    steps = sum(f["steps"] for f in s["frames"])
+    assert calls["velocity_half"] == steps, (d, calls["velocity_half"], steps)
 assert sa["initial_state_hash"] == sb["initial_state_hash"]
 for fa, fb in zip(sa["frames"], sb["frames"]):
     for key in fa:
