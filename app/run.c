@@ -554,6 +554,22 @@ static int simulate(run_state *r, const run_options *o)
             status = CS_EXIT_UNSTABLE;
             break;
         }
+        if (rc == CS_ERR_SCRIPT) { /* every rank sees the same rc */
+            cs_progress_finish(&progress);
+            char kept[64];
+            frames_kept(s->frames_written, kept, sizeof kept);
+            static char why[1024]; /* lives as long as the summary that points at it */
+            if (!cs_sim_script_conflict(r->sim, why, sizeof why))
+                snprintf(why, sizeof why, "no collision-free state follows the scripts");
+            if (root)
+                fprintf(stderr, "clothsim: %s: frame %d cannot follow its script: %s; %s in %s\n",
+                        r->scene->path, frame, why, kept, r->frames_dir);
+            s->status = "unstable";
+            s->error = why;
+            s->failed_frame = frame;
+            status = CS_EXIT_UNSTABLE;
+            break;
+        }
         if (rc != CS_OK) {
             cs_progress_finish(&progress);
             if (root)
@@ -712,6 +728,10 @@ int cs_run_main(int argc, char **argv)
     free(names);
     s->scene = scene->name;
     s->self_collision = scene->def.self_collision;
+    for (int c = 0; c < scene->def.ncloths; c++)
+        s->scripts = s->scripts || scene->def.cloths[c].nscripts > 0;
+    s->script_zones =
+        scene->def.self.script_zones == CS_SCRIPT_ZONES_HOLD ? "hold" : "follow";
     s->scene_file = scene->path;
     s->noverrides = o.noverrides;
     s->overrides = (const char *const *)o.overrides;

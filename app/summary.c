@@ -187,6 +187,10 @@ static cJSON *build_json(const cs_summary *s, builder *b)
         }
         append(b, ranks, o);
     }
+    if (s->scripts) {
+        add_str(b, root, "script_zones", s->script_zones);
+        add_num(b, root, "script_lag_max", s->script_lag_max);
+    }
     add_num(b, root, "total_seconds", s->total_seconds);
     add_num(b, root, "simulation_seconds", s->simulation_seconds);
     add_num(b, root, "output_seconds", s->output_seconds);
@@ -225,10 +229,13 @@ static cJSON *frame_json(const cs_summary *s, const cs_frame_record *f, builder 
         add_num(b, o, "impact_zones", (double)st->impact_zones);
         add_num(b, o, "max_zone_size", (double)st->max_zone_size);
         add_num(b, o, "held_zones", (double)st->held_zones);
+        add_num(b, o, "projected_zones", (double)st->projected_zones);
         add_num(b, o, "rewinds", (double)st->rewinds);
         add_num(b, o, "pair_searches", (double)st->pair_searches);
         add_num(b, o, "pair_traversals", (double)st->pair_traversals);
     }
+    if (s->scripts)
+        add_num(b, o, "script_lag", st->script_lag);
     if (st->intersections >= 0)
         add_num(b, o, "intersections", (double)st->intersections);
     if (f->body_penetration >= 0)
@@ -313,6 +320,8 @@ int cs_summary_open_records(cs_summary *s, const char *path, int keep, char *err
 int cs_summary_add_frame(cs_summary *s, const cs_frame_record *frame, char *err, size_t errlen)
 {
     builder b = {true};
+    if (frame->stats.script_lag > s->script_lag_max)
+        s->script_lag_max = frame->stats.script_lag;
     cJSON *o = frame_json(s, frame, &b);
     char *text = b.ok ? cJSON_PrintUnformatted(o) : NULL;
     cJSON_Delete(o);

@@ -59,6 +59,9 @@ typedef struct cs_summary {
     const char *status;              /* "running", "ok", "unstable", "interrupted", "failed" */
     const char *error;               /* why, when not "ok"; NULL otherwise */
     bool self_collision;             /* frames carry the self-collision counters */
+    bool scripts;                    /* frames carry script_lag */
+    const char *script_zones;        /* self_collision.script_zones, with scripts */
+    double script_lag_max;           /* s, the most any script fell behind its keys */
     int failed_frame;                /* the frame that went unstable, else -1 */
     int frames_requested;            /* simulated frames asked for */
     int frames_written;              /* files on disk, frame 0 included */

@@ -44,6 +44,10 @@ static const cyaml_strval_t scheme_names[] = {
     {"fixed", CS_COLLISION_FIXED},
     {"rewind", CS_COLLISION_REWIND},
 };
+static const cyaml_strval_t script_zones_names[] = {
+    {"follow", CS_SCRIPT_ZONES_FOLLOW},
+    {"hold", CS_SCRIPT_ZONES_HOLD},
+};
 static const cyaml_strval_t pruning_names[] = {
     {"speed", CS_PRUNING_SPEED},
     {"path", CS_PRUNING_PATH},

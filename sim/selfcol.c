@@ -181,7 +181,8 @@ void cs_selfcol_destroy(cs_selfcol *sc)
     void *arrays[] = {sc->edge, sc->tri, sc->ring_start, sc->ring, sc->pbox, sc->ebox, sc->tbox, sc->pdirty, sc->collided, sc->edirty,
                       sc->tdirty, sc->vdirty, sc->x_free, sc->x_before, sc->inv_mass, sc->zone,
                       sc->zone_list, sc->pt.p, sc->ee.p, sc->cpt.p, sc->cee.p,
-                      sc->prim_rank, sc->component, sc->bpt.p, sc->bee.p, sc->x_pass};
+                      sc->prim_rank, sc->component, sc->bpt.p, sc->bee.p, sc->x_pass,
+                      sc->kc, sc->kc_list};
     for (size_t k = 0; k < sizeof arrays / sizeof *arrays; k++)
         free(arrays[k]);
     cs_halo_free(&sc->bhalo);

@@ -37,6 +37,7 @@ typedef struct cs_selfcol_stats {
     long max_zone;             /* particles in the largest zone */
     long zones_across;         /* zone rigidifications spanning ranks */
     long held_zones;           /* zones that spanned two scripts, held in place */
+    long projected_zones;      /* zones that spanned two scripts, projected */
     long rewinds;              /* outer steps redone (rewind scheme) */
     long cache_searches;       /* searches of steps A and C (selfcol_cache.c) */
     long cache_builds;         /* of them, those that traversed the trees */
@@ -85,6 +86,28 @@ typedef struct cs_pair_cache {
     long skin_skips;             /* pairs the skin spared the makers, in all */
 } cs_pair_cache;
 
+/* A collision inside an impact zone that spans two prescribed motions, as
+ * a linear constraint on the span's end positions (selfcol_project.c):
+ * n . sum_k c_k x_k >= gap, n and the weights c from the collision. */
+typedef struct cs_zone_constraint {
+    int v[4];
+    double c[4], n[3];
+    double gap;
+    double lambda; /* its multiplier in the projection */
+} cs_zone_constraint;
+
+/* Why step C stopped (CS_ERR_SCRIPT): a zone that spans two prescribed
+ * motions and has no collision-free state that follows them. */
+typedef struct cs_script_conflict {
+    bool found;
+    double t;                  /* the outer step's end */
+    int zone_size;
+    int scripts[4], nscripts;  /* the first scripts in it (-1: pins) */
+    bool more_scripts;
+    double where[3];           /* a vertex of its worst collision */
+    double shortfall;          /* m the worst constraint lacks (0: passes ran out) */
+} cs_script_conflict;
+
 typedef struct cs_selfcol {
     int n, ne, nt;
     int *edge, *tri;           /* global particle indices */
@@ -106,6 +129,12 @@ typedef struct cs_selfcol {
     cs_pair_list cpt, cee;     /* step C candidates of one pass */
     int *zone;                 /* union-find parent per particle, -1 outside zones */
     int *zone_list;            /* scratch */
+    /* step C's zones across prescribed motions: the collisions found in
+     * its zone passes, kept for the projection (allocated at first use) */
+    cs_zone_constraint *kc;
+    int nkc, kc_cap;
+    int *kc_list;              /* scratch: one zone's constraints */
+    cs_script_conflict conflict;
     /* Section 7: pairs go to the lowest rank owning one of their particles;
      * pairs across ranks ("boundary") are grouped into connected components,
      * each processed by one rank before the pairs internal to each rank */

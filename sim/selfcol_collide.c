@@ -428,15 +428,44 @@ static void hold_script(cs_sim *sim, int s, double span)
     sim->script_lag[s] = held_lag;
 }
 
-/* Moves every impact zone rigidly; pinned and scripted particles weigh
- * far more than the rest and keep their prescribed positions. A zone that
- * holds vertices of two scripts cannot move rigidly with both; it stays
- * where it was collision free, and so do those scripts (hold_script): they
- * wait, then catch up (step.c's script_targets). */
-static void rigidify_zones(cs_sim *sim, double span, double *dv)
+/* A zone no end state could follow its scripts in: its size, scripts and
+ * where (step C then stops the run, CS_ERR_SCRIPT). */
+static void note_conflict(cs_sim *sim, const int *list, int count)
+{
+    cs_script_conflict *why = &sim->selfcol->conflict;
+    why->found = true;
+    why->t = sim->t;
+    why->zone_size = count;
+    why->nscripts = 0;
+    why->more_scripts = false;
+    for (int k = 0; k < count; k++) {
+        int i = list[k];
+        if (sim->is_free[i])
+            continue;
+        int s = sim->script_of[i], seen = 0;
+        while (seen < why->nscripts && why->scripts[seen] != s)
+            seen++;
+        if (seen < why->nscripts)
+            continue;
+        if (why->nscripts < 4)
+            why->scripts[why->nscripts++] = s;
+        else
+            why->more_scripts = true;
+    }
+}
+
+/* Moves every impact zone: rigidly, with pinned and scripted particles
+ * far heavier than the rest and kept at their prescribed positions; a zone
+ * that holds vertices of two prescribed motions, which no rigid motion
+ * follows, by the projection of selfcol_project.c (script_zones: follow),
+ * or held where it was collision free with its scripts (hold_script: they
+ * wait, then catch up in step.c's script_targets). Returns false when a
+ * zone has no answer that follows its scripts (sc->conflict says which). */
+static bool move_zones(cs_sim *sim, double span, double *dv)
 {
     cs_selfcol *sc = sim->selfcol;
     int n = sc->n;
+    bool follow = sim->def.self.script_zones == CS_SCRIPT_ZONES_FOLLOW, ok = true;
     /* scratch, free during step C: v_half, and CG's explicit start */
     double *u = sim->v_half, *mw = sim->cg.explicit_z;
     double heaviest = 0;
@@ -455,8 +484,14 @@ static void rigidify_zones(cs_sim *sim, double span, double *dv)
             if (sc->zone[i] >= 0 && sc_zone_find(sc->zone, i) == root)
                 sc->zone_list[count++] = i;
         double vcm[3], w[3];
-        bool hold = zone_spans_scripts(sim, sc->zone_list, count);
-        if (hold) {
+        bool spans = zone_spans_scripts(sim, sc->zone_list, count);
+        if (spans && follow) {
+            sc->stats.projected_zones++;
+            if (!sc_project_zone(sc, root, sim->x, &sc->conflict)) {
+                note_conflict(sim, sc->zone_list, count);
+                ok = false;
+            }
+        } else if (spans) {
             for (int k = 0; k < count; k++) {
                 int i = sc->zone_list[k];
                 memcpy(sim->x + 3 * i, sc->x_free + 3 * i, 3 * sizeof(double));
@@ -483,6 +518,7 @@ static void rigidify_zones(cs_sim *sim, double span, double *dv)
                 break;
             }
     }
+    return ok;
 }
 
 /* One colliding pair's response in step C: inelastic on the effective
@@ -526,33 +562,52 @@ static void respond_all(cs_selfcol *sc, const cs_pair_list *pt, const cs_pair_li
         collision_respond(sc, ee->p + j, true, x, u, dv, span, elastic);
 }
 
+/* True when step C keeps the zone passes' collisions for the projection of
+ * zones across prescribed motions: scripts to follow (pins alone are one
+ * motion, which a rigid zone follows). */
+static bool keeps_constraints(const cs_sim *sim)
+{
+    return sim->nscripts > 0 && sim->def.self.script_zones == CS_SCRIPT_ZONES_FOLLOW;
+}
+
 /* Impact zones over all ranks: every rank merges every colliding pair's
- * particles in the same order, so all hold the same zones. Returns 0 or
- * -1. */
+ * particles in the same order, so all hold the same zones, and keeps the
+ * same constraints for the projection. Returns 0 or -1. */
 static int merge_zones(cs_sim *sim)
 {
     cs_selfcol *sc = sim->selfcol;
     int nmine = sc->cpt.n + sc->cee.n;
-    int *mine = malloc(sizeof *mine * 4 * ((size_t)nmine + 1));
+    int *mine = malloc(sizeof *mine * 5 * ((size_t)nmine + 1));
     if (!mine)
         return -1;
     for (int l = 0, m = 0; l < 2; l++) {
         const cs_pair_list *list = l == 0 ? &sc->cpt : &sc->cee;
-        for (int j = 0; j < list->n; j++, m++)
-            memcpy(mine + 4 * m, list->p[j].v, 4 * sizeof *mine);
+        for (int j = 0; j < list->n; j++, m++) {
+            memcpy(mine + 5 * m, list->p[j].v, 4 * sizeof *mine);
+            mine[5 * m + 4] = l; /* an edge pair */
+        }
     }
     void *gathered;
     int nall;
-    int rc = cs_par_allgather_items(sim->par, mine, nmine, 4 * sizeof *mine, &gathered, &nall);
+    int rc = cs_par_allgather_items(sim->par, mine, nmine, 5 * sizeof *mine, &gathered, &nall);
     free(mine);
     if (rc)
         return -1;
     const int *all = gathered;
-    for (int k = 0; k < nall; k++)
+    bool keep = keeps_constraints(sim);
+    for (int k = 0; k < nall; k++) {
+        const int *v = all + 5 * k;
         for (int q = 1; q < 4; q++)
-            sc_zone_union(sc->zone, all[4 * k], all[4 * k + q]);
+            sc_zone_union(sc->zone, v[0], v[q]);
+        cs_pair p;
+        double c[4], nrm[3];
+        memcpy(p.v, v, sizeof p.v);
+        if (keep && pair_collides(sc, &p, v[4] != 0, sim->x, c, nrm) &&
+            sc_zone_constraint_add(sc, v, c, nrm, sim->def.self.thickness) != 0)
+            rc = -1;
+    }
     free(gathered);
-    return 0;
+    return rc;
 }
 
 /* Step C on several ranks: each pass starts from positions synchronised to
@@ -584,7 +639,9 @@ long cs_selfcol_collide(cs_sim *sim, double span, int k, bool detect_only)
      * zones); the elastic push moves positions, as in B.2 (Section 5). */
     double *dv = sim->v0;
     memset(dv, 0, bytes);
-    long first_pass = 0;
+    sc->nkc = 0;
+    sc->conflict.found = false;
+    long projected_before = sc->stats.projected_zones, first_pass = 0;
     int zones_formed = 0;
     for (int pass = 0;; pass++) {
         if (pass > 0) { /* what moved since the last pass, on any rank */
@@ -625,7 +682,8 @@ long cs_selfcol_collide(cs_sim *sim, double span, int k, bool detect_only)
             if (merge_zones(sim) != 0)
                 abort(); /* out of memory in the last resort: nothing safe to do */
             zones_formed++;
-            rigidify_zones(sim, span, dv);
+            if (!move_zones(sim, span, dv))
+                break; /* the run stops: the state need not be collision free */
         } else {
             if (sc_distribute_boundary(sim, &sc->cpt, &sc->cee) != 0)
                 abort();
@@ -638,9 +696,23 @@ long cs_selfcol_collide(cs_sim *sim, double span, int k, bool detect_only)
             respond_all(sc, &sc->cpt, &sc->cee, x, u, dv, span, &elastic);
         }
         if (pass > d->zone_iterations + 1000) {
-            /* cannot happen in exact arithmetic (zones only grow); stop
-             * every particle at the collision-free state rather than loop
-             * forever, the scripts too (their clocks wait) */
+            /* cannot happen in exact arithmetic for rigid zones (zones only
+             * grow); a projected one may chase its collisions around. The
+             * scripts cannot be followed where a zone spans two of them:
+             * say so; else stop every particle at the collision-free state
+             * rather than loop forever, the scripts too (their clocks
+             * wait) */
+            if (sc->stats.projected_zones > projected_before && sc->nkc > 0) {
+                int count = 0;
+                for (int i = 0; i < n; i++)
+                    if (sc->zone[i] >= 0 &&
+                        sc_zone_find(sc->zone, i) == sc_zone_find(sc->zone, sc->kc[0].v[0]))
+                        sc->zone_list[count++] = i;
+                memcpy(sc->conflict.where, x + 3 * sc->kc[0].v[3], sizeof sc->conflict.where);
+                sc->conflict.shortfall = 0;
+                note_conflict(sim, sc->zone_list, count);
+                break;
+            }
             memcpy(x, sc->x_free, bytes);
             for (int s = 0; s < sim->nscripts; s++)
                 hold_script(sim, s, span);

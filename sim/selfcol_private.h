@@ -52,6 +52,16 @@ bool sc_pair_respond(const cs_selfcol *sc, const cs_pair *p, bool is_edge, const
 double sc_ring_side(const cs_selfcol *sc, const double *x, int point, const double nrm[3]);
 bool sc_sides_apart(const double *const p[4], int split, double gap);
 int sc_zone_find(int *parent, int i);
+/* Keeps a collision found in a zone pass (weights c, normal n oriented from
+ * the side it started on) as a constraint for sc_project_zone. Returns 0
+ * or -1 (no memory). */
+int sc_zone_constraint_add(cs_selfcol *sc, const int v[4], const double c[4], const double n[3],
+                           double thickness);
+/* Moves the free vertices of zone root in x the least that makes each of
+ * its kept constraints hold, prescribed vertices fixed (selfcol_project.c).
+ * Returns false, with where and how short in why, when no end state was
+ * found. */
+bool sc_project_zone(cs_selfcol *sc, int root, double *x, cs_script_conflict *why);
 void sc_zone_union(int *parent, int a, int b);
 
 #endif

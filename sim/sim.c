@@ -33,6 +33,7 @@ cs_self_collision_def cs_default_self_collision_def(void)
         .edge_flip_epsilon = 0.5,
         .zone_iterations = 8,
         .scheme = CS_COLLISION_FIXED,
+        .script_zones = CS_SCRIPT_ZONES_FOLLOW,
         .pruning = CS_PRUNING_SPEED,
         .verify = false,
     };

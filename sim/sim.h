@@ -36,6 +36,8 @@ enum {
     CS_ERR_INVALID = -1,   /* a definition that makes no sense */
     CS_ERR_NOMEM = -2,
     CS_ERR_UNSTABLE = -3,  /* NaN or runaway velocity detected */
+    CS_ERR_SCRIPT = -4,    /* step C found no collision-free state that
+                              follows the scripts (cs_sim_script_conflict) */
 };
 
 /* -------------------------------------------------------------- geometry */
@@ -278,6 +280,18 @@ typedef enum cs_collision_scheme {
                                  rewind and retry with k_i halved, down to 1 */
 } cs_collision_scheme;
 
+/* An impact zone holding vertices of two prescribed motions (two scripts,
+ * a pin and a script), which no rigid motion can follow. */
+typedef enum cs_script_zones {
+    CS_SCRIPT_ZONES_FOLLOW = 0, /* the scripts go on exactly; the zone's free
+                                   vertices are projected off the collisions
+                                   around them (selfcol_project.c); where no
+                                   answer exists the run stops and says so */
+    CS_SCRIPT_ZONES_HOLD,       /* the zone stays where it was collision
+                                   free and its scripts wait (they lag, as
+                                   the summary reports) */
+} cs_script_zones;
+
 /* Step A's broad phase (docs/performance-log.md, "Step A's boxes along
  * the path"). */
 typedef enum cs_pair_pruning {
@@ -298,6 +312,7 @@ typedef struct cs_self_collision_def {
                                   conservative)                         (0.5) */
     int zone_iterations;       /* step C passes before impact zones      (8) */
     cs_collision_scheme scheme;
+    cs_script_zones script_zones; /* zones across scripts           (follow) */
     cs_pair_pruning pruning;   /* step A's broad phase              (speed) */
     bool verify;               /* count intersecting triangle pairs at each
                                   frame end (an independent check)  (false) */
@@ -401,7 +416,12 @@ typedef struct cs_frame_stats {
     long collision_passes;     /* step C iterations */
     long impact_zones;         /* zones formed */
     long max_zone_size;        /* particles in the largest zone */
-    long held_zones;           /* zones spanning two scripts, held where collision free */
+    long held_zones;           /* zones spanning two scripts, held where collision free
+                                  (script_zones: hold) */
+    long projected_zones;      /* zones spanning two scripts whose free vertices
+                                  were projected around them (script_zones: follow) */
+    double script_lag;         /* s: the most any script is behind its keys at
+                                  the frame's end (0 unless held) */
     long rewinds;              /* outer steps redone (rewind scheme) */
     long pair_searches;        /* searches of steps A and C */
     long pair_traversals;      /* of them, those that traversed the trees */
@@ -440,6 +460,11 @@ int cs_sim_advance_frame(cs_sim *sim, cs_frame_stats *stats);
  * saw it, the speed seen (infinity for NaN) and the bound it passed (see
  * sim/runaway.c for what the bound allows); false when none was seen. */
 bool cs_sim_runaway(const cs_sim *sim, const char **stage, double *speed, double *limit);
+
+/* After cs_sim_advance_frame returned CS_ERR_SCRIPT: a sentence naming
+ * the time, the zone (its size, where it is) and the scripted sets (cloth
+ * and script indices) that no collision-free state could follow. */
+bool cs_sim_script_conflict(const cs_sim *sim, char *buf, size_t len);
 
 /* Rank 0's value, on every rank (a collective): how the ranks agree to go
  * on or stop after rank 0 has written a frame. */

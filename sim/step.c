@@ -471,6 +471,10 @@ static int outer_step(cs_sim *sim, int k)
         }
         STAGE_BEGIN(sim, CS_STAGE_COLLISIONS);
         cs_selfcol_collide(sim, sim->t - t0, k, false);
+        if (sc->conflict.found) { /* the same on every rank */
+            STAGE_END(sim, CS_STAGE_COLLISIONS);
+            return CS_ERR_SCRIPT;
+        }
         cs_runaway_check(sim, sim->v, CS_STAGE_COLLISIONS);
         STAGE_END(sim, CS_STAGE_COLLISIONS);
         return cs_runaway_end_step(sim, cs_runaway_not_finite(sim, NULL)) ? CS_OK : CS_ERR_UNSTABLE;
@@ -573,11 +577,15 @@ int cs_sim_advance_frame(cs_sim *sim, cs_frame_stats *stats)
             stats->impact_zones = self.zones - self0.zones;
             stats->max_zone_size = self.max_zone;
             stats->held_zones = self.held_zones - self0.held_zones;
+            stats->projected_zones = self.projected_zones - self0.projected_zones;
             stats->rewinds = self.rewinds - self0.rewinds;
             stats->pair_searches = self.cache_searches - self0.cache_searches;
             stats->pair_traversals = self.cache_builds - self0.cache_builds;
         }
         stats->intersections = intersections;
+        for (int sc = 0; sc < sim->nscripts; sc++)
+            if (!sim->scripts[sc].released)
+                stats->script_lag = fmax(stats->script_lag, sim->script_lag[sc]);
     }
     return status;
 }
