@@ -294,7 +294,7 @@ int cs_bvh_collect(const cs_bvh *A, const cs_bvh *B, int rank, cs_bvh_work *w,
         /* the task's list filled in a copy on this thread's stack: the
          * tasks' lists lie side by side, four to a cache line, and two
          * threads pushing onto neighbours passed that line back and forth
-         * at every pair (a quarter of the traversal's samples) */
+         * at every pair, a large share of the traversal's time */
         cs_index_pairs found = w->found[t];
         found.n = 0;
         traversal tr = {A, B, A == B, rank, 0, NULL, &found, 0};

@@ -153,9 +153,8 @@ void cs_system_apply(const cs_sim *sim, const double *v, double *out)
 /* The solve runs in one parallel region: its passes are worksharing loops
  * whose ends are barriers, and every thread sums the block partials
  * itself, in block order, so all hold the same scalars and take the same
- * branches. A region per pass cost a fork and a join each, about 4.5 us
- * in a run on this VM against 1.5 us for a barrier, 30 times a step at
- * 100 x 100. Messages (more than one rank) go through one thread, the
+ * branches. A region per pass would cost a fork and a join each, several
+ * times a barrier's cost, dozens of times a step. Messages (more than one rank) go through one thread, the
  * others waiting at the end of its single block. */
 
 /* Sums block partials in block order and over ranks (with the maximum of
@@ -320,8 +319,7 @@ int cs_cg_solve(cs_sim *sim, const double *v0, const double *rhs, double *v, con
         /* Two passes an iteration: the direction's update p = y + beta p is
          * folded into the next operator pass, which applies A to y instead
          * and takes P A p = P A y + beta q (A and P are fixed within the
-         * solve); the third pass and its fork and join had 2% of a contact
-         * frame's samples (the first iteration applies A to p, which the
+         * solve), saving a third pass and its fork and join (the first iteration applies A to p, which the
          * setup pass made). */
         int it = 0;
         double beta = 0, pending = 0; /* pending: the last alpha, not yet in z */

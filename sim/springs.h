@@ -60,8 +60,8 @@ void cs_springs_free(cs_springs *s);
 /* Two row entries at a time, one per lane of GCC's two-double vector
  * (SSE2 on x86-64, NEON on AArch64): the spring kernels were bound by
  * scalar arithmetic, not memory (halving the directions' bytes with
- * floats gained nothing measurable; pairs took CG's setup pass 23% and
- * the damping pass 29% faster). A row sums its even and odd entries in
+ * floats gained nothing measurable; pairs made CG's setup pass and the
+ * damping pass markedly faster). A row sums its even and odd entries in
  * the two lanes and adds the lanes at the end: one fixed order at any
  * thread count. */
 typedef double cs_pair2 __attribute__((vector_size(16)));
