@@ -1,5 +1,5 @@
 #!/bin/sh
-# fuzz/seed.sh: lays the fuzzers' seed corpus and working folder (issue 12)
+# fuzz/seed.sh: lays the fuzzers' seed corpus and working folder
 # in build-fuzz/ (or $1); generated, never committed. The fuzzers write
 # what they find into corpus/scene/ and corpus/mesh/ (made here if missing,
 # kept between runs); the seeds are laid anew each time.

@@ -278,7 +278,7 @@ typedef enum cs_collision_scheme {
                                  rewind and retry with k_i halved, down to 1 */
 } cs_collision_scheme;
 
-/* Step A's broad phase (docs/performance-log.md, "Step A's boxes along
+/* Step A's broad phase (docs/performance.md, "Step A's boxes along
  * the path"). */
 typedef enum cs_pair_pruning {
     CS_PRUNING_SPEED = 0, /* the paper's non-aggressive pruning: a particle's

@@ -2,7 +2,7 @@
 # cli_scene_reference.sh CLOTHSIM_EXE SOURCE_DIR: README.md's scene reference
 # tables are the ones `clothsim help scene --markdown` prints from the table
 # of keys (import/scene_keys.def), block by block between the
-# <!-- scene-reference:begin SECTION --> and end markers (issue 11); and
+# <!-- scene-reference:begin SECTION --> and end markers; and
 # `clothsim help scene` prints the reference, an unknown key names the
 # nearest known one.
 set -eu

@@ -508,7 +508,7 @@ static void test_reference_example(void **state)
     cs_scene_destroy(s);
 }
 
-/* ------------------------------------------ friction schedules (issue 13) */
+/* ---------------------------------------------------- friction schedules */
 
 /* bodies[].friction_keys: the keys as loaded, and no friction key beside. */
 static void test_friction_keys_loaded(void **state)

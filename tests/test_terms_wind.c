@@ -1,4 +1,4 @@
-/* Every term of the model checked on its own (issue 14, item 4): the wind
+/* Every term of the model checked on its own: the wind
  * of Section 8 (velocity drag, the ground boost, the gust field, a sheet
  * driven by a gust), each against a closed form. The other terms are in
  * test_terms.c, with the table of mutations these files catch. */
