@@ -17,8 +17,8 @@ estimated memory traffic against a STREAM triad measured in the same run.
 usage: bench/speed.py [--build DIR] [--repeat N] [--frames N] [--sizes 50,100,200]
                       [--modes on,off] [--step-limit undamped|damped]
                       [--pruning speed|path] [--out DIR]
-Writes DIR/speed.csv and DIR/speed.md (default out/speed). Numbers go in the
-README by hand, with the machine. A Release build is expected.
+Writes DIR/speed.csv and DIR/speed.md (default out/speed). Numbers go in
+docs/performance.md by hand, with the machine. A Release build is expected.
 """
 import argparse
 import json
@@ -79,7 +79,7 @@ def triad(build):
 
 
 def machine():
-    """The CPU model, its count and caches (lscpu), for the README's "with the machine"."""
+    """The CPU model, its count and caches (lscpu), for docs/performance.md's "with the machine"."""
     model = "unknown CPU"
     try:
         with open("/proc/cpuinfo") as f:
