@@ -86,8 +86,8 @@ static bool contained(const cs_selfcol *sc, const double T[3])
 /* ------------------------------------------------------------ the skin
  *
  * Step A's makers measure the exact distance of every pair whose boxes
- * overlap, and keep almost none: on the 100 x 100 bench sheet in free fall
- * about 70,000 a search, all of them farther than the thickness. As
+ * overlap, and keep almost none: on the benchmark sheet in free fall tens
+ * of thousands a search, all of them farther than the thickness. As
  * molecular dynamics does with a Verlet list's skin, the cache keeps each
  * pair's distance at the positions it was built from (x_ref), measured the
  * first time the pair is asked about; since then the distance changed by at

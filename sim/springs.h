@@ -76,8 +76,8 @@ static inline cs_pair2 cs_pair2_load(const double *p)
 /* u[d] = component d of the far ends of entries e and e + 1, less the
  * row's own. The ends' addresses are taken once, in pointer arithmetic, so
  * the three components are loads at fixed offsets (indexing with the int
- * 3 * other + d made GCC sign-extend each of the six: 12 of the CG
- * operator's 43 instructions per pair of entries). */
+ * 3 * other + d made GCC sign-extend each of the six, a good part of
+ * the CG operator's instructions). */
 static inline void cs_pair2_gather(const double *x, const int *other, int e, const double *own,
                                    cs_pair2 u[3])
 {
