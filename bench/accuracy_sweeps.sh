@@ -1,6 +1,6 @@
 #!/bin/sh
-# bench/accuracy_sweeps.sh [BUILD_DIR] [NAME...]: the sweeps of the README's
-# "What accuracy costs in time": each knob that trades accuracy for time,
+# bench/accuracy_sweeps.sh [BUILD_DIR] [NAME...]: the sweeps of
+# docs/accuracy.md, "What accuracy costs in time": each knob that trades accuracy for time,
 # swept with `clothsim sweep` on a scene at its committed (test) size,
 # shortened with --set time.frames=N. NAME picks sweeps (default: all):
 #

@@ -1,5 +1,5 @@
 /* cg_speed.c: the implicit damping solve's kernels alone, on a sheet of
- * N x N quads (issue 10: where a contact frame's time goes). CG's operator
+ * N x N quads (where a contact frame's time goes). CG's operator
  * (cs_system_apply, the pass that takes a third to half of a contact
  * frame) is timed over many calls, best of 5, and a whole solve
  * (cs_cg_solve from rest, tolerance 1e-6 m/s) best of 5; the results'

@@ -1,4 +1,4 @@
-/* levelset_speed.c: what mesh bodies cost (issue 4), for the README; a
+/* levelset_speed.c: what mesh bodies cost, for docs/performance.md; a
  * benchmark, never a timed test.
  *
  *   bench_levelset_speed [ASSETS_DIR]

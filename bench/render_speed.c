@@ -1,4 +1,4 @@
-/* render_speed.c: how fast the renderer is, for the README (not a timed
+/* render_speed.c: how fast the renderer is, for docs/performance.md (not a timed
  * test). A cloth of about 200,000 triangles, wrinkled over a ball on the
  * ground, is ray traced at 1280x720 with 16 samples per pixel (rays per
  * second, seconds per frame) and drawn by the preview (frames per second).

@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""bench/speed.py: speed at resolution (issue 10), measured the way a user runs.
+"""bench/speed.py: speed at resolution, measured the way a user runs.
 
 Runs scenes/bench/sheet_ball.yaml (a 1 m sheet falling on a ball on the
 ground) at 50x50, 100x100 and 200x200 quads (5,000, 20,000 and 80,000
@@ -17,8 +17,8 @@ estimated memory traffic against a STREAM triad measured in the same run.
 usage: bench/speed.py [--build DIR] [--repeat N] [--frames N] [--sizes 50,100,200]
                       [--modes on,off] [--step-limit undamped|damped]
                       [--pruning speed|path] [--out DIR]
-Writes DIR/speed.csv and DIR/speed.md (default out/speed). Numbers go in the
-README by hand, with the machine. A Release build is expected.
+Writes DIR/speed.csv and DIR/speed.md (default out/speed). Numbers go in
+docs/performance.md by hand, with the machine. A Release build is expected.
 """
 import argparse
 import json
@@ -79,7 +79,7 @@ def triad(build):
 
 
 def machine():
-    """The CPU model, its count and caches (lscpu), for the README's "with the machine"."""
+    """The CPU model, its count and caches (lscpu), for docs/performance.md's "with the machine"."""
     model = "unknown CPU"
     try:
         with open("/proc/cpuinfo") as f:
@@ -169,7 +169,7 @@ def main():
                 "ns_per_spring_step": 1e9 * inner / max(steps * springs, 1),
             }
             # traffic model of one step, if every byte came from memory
-            # (sim/springs.c, sim/cg.c as of 2026-12-03): every spring is an
+            # (sim/springs.c, sim/cg.c; update it when their passes change): every spring is an
             # entry in both its ends' rows. The prepare pass (twice a step)
             # reads an entry's far end (4 B) and 3 constants (24 B) and
             # writes its direction (24 B) and magnitude (8 B): 120 B per
@@ -221,7 +221,7 @@ def main():
         if on and off and on[0]["free_fall_frames"] and off[0]["free_fall_frames"]:
             md.append("\n%dx%d: a free-fall frame (median over the %d frames before the first body "
                       "contact) costs %.3f s with self-collision and %.3f s without: %.2f times "
-                      "(issue 10: at most 1.3)" % (
+                      "(the target: at most 1.3)" % (
                           n, n, on[0]["free_fall_frames"], on[0]["free_fall_s_per_frame"],
                           off[0]["free_fall_s_per_frame"],
                           on[0]["free_fall_s_per_frame"] / off[0]["free_fall_s_per_frame"]))

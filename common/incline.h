@@ -1,6 +1,6 @@
 /* incline.h: the analytic solution of the paper's validation (Figs. 7 and
  * 8): a rigid body sliding on an incline with Coulomb friction. The one
- * definition, for `clothsim sweep --analytic incline` (app/sweep_analytic.c)
+ * definition, for `clothsim sweep --analytic incline` (app/sweep_metrics.c)
  * and the tests (tests/incline_analytic.h). Header only, plain C: numbers
  * in, numbers out.
  *

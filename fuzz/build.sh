@@ -1,5 +1,5 @@
 #!/bin/sh
-# fuzz/build.sh: builds the libFuzzer targets (issue 12) with clang into
+# fuzz/build.sh: builds the libFuzzer targets with clang into
 # build-fuzz/ (or $1), a separate CMake build of the whole project with
 # -DCS_FUZZ=ON, every library instrumented for coverage
 # (-fsanitize=fuzzer-no-link) and checked by AddressSanitizer and

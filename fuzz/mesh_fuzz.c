@@ -1,4 +1,4 @@
-/* mesh_fuzz.c: libFuzzer target for the mesh import (issue 12).
+/* mesh_fuzz.c: libFuzzer target for the mesh import.
  *
  * The first byte of an input chooses the file's extension (low 3 bits:
  * ply obj stl glb gltf fbx dae off, which is what assimp goes by) and the

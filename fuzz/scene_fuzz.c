@@ -1,4 +1,4 @@
-/* scene_fuzz.c: libFuzzer target for the scene loader (issue 12).
+/* scene_fuzz.c: libFuzzer target for the scene loader.
  *
  * Each input is a scene file's text, loaded with cs_scene_load_string (the
  * in-memory twin of cs_scene_load: the same parse, schema, conversion,

@@ -1,5 +1,5 @@
 #!/bin/sh
-# fuzz/seed.sh: lays the fuzzers' seed corpus and working folder (issue 12)
+# fuzz/seed.sh: lays the fuzzers' seed corpus and working folder
 # in build-fuzz/ (or $1); generated, never committed. The fuzzers write
 # what they find into corpus/scene/ and corpus/mesh/ (made here if missing,
 # kept between runs); the seeds are laid anew each time.
@@ -18,7 +18,7 @@
 #                   ico4.obj at the bunny's size, 642 vertices against
 #                   the bunny's 35,947, so that each of bunny_drape's
 #                   mutants imports a small mesh), cache/ (level-set cache)
-#   artifacts/      where the README's commands put what they find
+#   artifacts/      where fuzz/README.md's commands put what they find
 set -eu
 root=$(cd "$(dirname "$0")/.." && pwd)
 build=${1:-"$root/build-fuzz"}

@@ -333,7 +333,8 @@ int cs_scene_load_string(const char *text, const char *origin,
 void cs_scene_destroy(cs_scene *scene);
 
 /* The scene file reference, made from the table of keys (scene_keys.def):
- * as text for `clothsim help scene`, or (markdown) as the tables README.md
+ * as text for `clothsim help scene`, or (markdown) as the tables
+ * docs/scene-reference.md
  * holds between <!-- scene-reference:begin SECTION --> and
  * <!-- scene-reference:end SECTION --> lines. */
 void cs_scene_reference(FILE *out, bool markdown);

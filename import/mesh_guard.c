@@ -1,8 +1,8 @@
 /* mesh_guard.c: assimp in a child process with limits.
  *
  * Checking a file before assimp reads it (mesh_check.c) stops the corrupt
- * files we know of, but not all that assimp 5.2 does to itself: issue 12
- * met a corrupt binary FBX that double-frees inside its importer, and any
+ * files we know of, but not all that assimp 5.2 does to itself: a corrupt
+ * binary FBX is known to double-free inside its importer, and any
  * reader may loop, crash or allocate what a file claims. So every mesh file is read in a
  * forked child: RLIMIT_CPU bounds its CPU time, RLIMIT_DATA its memory
  * (counted from what the process already maps: AddressSanitizer reserves

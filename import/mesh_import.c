@@ -7,22 +7,18 @@
  * joining merges all NaN vertices into one), units and the placement are
  * applied, and the mesh is repaired and analysed (mesh_repair.c).
  *
- * A mesh file must never crash or hang the command that reads it (issue
- * 12). So each of the three readers below (cs_mesh_read, cs_mesh_import,
+ * A mesh file must never crash or hang the command that reads it. So each of the three readers below (cs_mesh_read, cs_mesh_import,
  * cs_mesh_catalog_read) does its work in a child process with limits
  * (mesh_guard.c) and sends back plain numbers; in that child the file is
  * checked before assimp sees it (mesh_check.c), assimp reads it without
  * post-processing, its faces are checked, and only then does assimp
  * triangulate.
  *
- * What that costs, measured on a 2-core machine shared with other work
- * (load about 4, so roughly), Release build, each a fresh process as a
- * command is, median of 7 runs interleaved with the code before issue 12:
- * cs_mesh_import of assets/stanford-bunny.obj (2.4 MB) 438 ms before, 491
- * ms after, 464 ms with CLOTHSIM_IMPORT_ISOLATION=0; CPU time 327, 351 and
- * 326 ms: the checks cost next to nothing, the child about 25 ms of CPU.
- * The bunny as a binary PLY frame through cs_mesh_read: CPU time 202 ms
- * before, 120 ms after (PLY is no longer joined, see cs_mesh_read).
+ * What that costs: the checks next to nothing beside assimp's own read,
+ * the child process a few tens of milliseconds of CPU a file
+ * (CLOTHSIM_IMPORT_ISOLATION=0 reads in the process itself, to compare;
+ * docs/performance.md has the numbers). PLY frames are read without
+ * joining vertices (see cs_mesh_read), which more than pays for the child.
  */
 #include "import/mesh_internal.h"
 

@@ -75,8 +75,8 @@ typedef enum cs_mesh_kind {
 } cs_mesh_kind;
 
 /* The largest polygon read: assimp's triangulation takes quadratic time in
- * a face's corners (an OBJ face of 300,000 corners ran for minutes; 30,000
- * take 8 s, 10,000 under a second). */
+ * a face's corners (a face of hundreds of thousands of corners runs for
+ * minutes); a face of this many is read in well under a second. */
 #define CS_MESH_MAX_CORNERS 10000
 
 /* The most digits of a number read from a text file: a double needs 17

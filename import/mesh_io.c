@@ -360,7 +360,7 @@ int cs_mesh_write(const char *path, cs_mesh_format format, int nmeshes,
     }
     /* Assimp exports into memory and the bytes are written here, every
      * write checked: assimp's own file writer ignores a short fwrite and
-     * fclose's result, so a full disk gave a truncated frame (issue 12). */
+     * fclose's result, so a full disk would give a truncated frame. */
     const struct aiExportDataBlob *blob =
         scene ? aiExportSceneToBlob(scene, FORMATS[format].assimp_id, 0) : NULL;
     free_scene(scene);

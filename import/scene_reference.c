@@ -1,7 +1,7 @@
 /* scene_reference.c: the scene file reference, printed from the table of
  * keys (scene_keys.def): `clothsim help scene`, and with --markdown the
- * tables of README.md's "Scene file reference" (tests/cli_scene_reference.sh
- * fails when the two disagree). */
+ * tables of docs/scene-reference.md (tests/cli_scene_reference.sh fails
+ * when the two disagree). */
 #include "import/import.h"
 
 #include <stdio.h>

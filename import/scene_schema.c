@@ -1,6 +1,6 @@
 /* scene_schema.c: the libcyaml schema of a scene file, the key descriptors,
- * and queries on them; all made from scene_keys.def, which README.md's scene
- * reference is printed from too (tests/cli_scene_reference.sh). */
+ * and queries on them; all made from scene_keys.def, which
+ * docs/scene-reference.md is printed from too (tests/cli_scene_reference.sh). */
 #include "import/scene_schema.h"
 
 #include <stddef.h>

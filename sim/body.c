@@ -104,7 +104,7 @@ double cs_body_posed_phi(const cs_body_def *b, const cs_body_pose *pose, const d
     /* Most bodies never turn (the ground, a resting ball): the identity's
      * products give the same numbers but for the sign of a zero, which
      * none of the callers' tests tells apart (the same state hashes), and
-     * were a quarter of this function's samples in B.4 */
+     * are a large part of this function's time in B.4 */
     double p[3], g[3];
     cs_sub(x, pose->c, p);
     if (!pose->unrotated)

@@ -158,9 +158,9 @@ static inline const int *prim_vertices(const cs_bvh *t, const int *k, int *n)
 }
 
 /* Pairs sharing a particle are never a collision pair (the makers reject
- * them first), and such pairs always overlap: on the 100 x 100 bench they
- * were about 60,000 of 73,000 point/triangle and 150,000 of 207,000
- * edge/edge box overlaps per search of the kept pairs. */
+ * them first), and such pairs always overlap: on the benchmark sheet they
+ * are most of the point/triangle and edge/edge box overlaps of a search
+ * of the kept pairs. */
 static inline bool share_vertex(const cs_bvh *A, int a, const cs_bvh *B, int b)
 {
     int na, nb;
@@ -294,7 +294,7 @@ int cs_bvh_collect(const cs_bvh *A, const cs_bvh *B, int rank, cs_bvh_work *w,
         /* the task's list filled in a copy on this thread's stack: the
          * tasks' lists lie side by side, four to a cache line, and two
          * threads pushing onto neighbours passed that line back and forth
-         * at every pair (a quarter of the traversal's samples) */
+         * at every pair, a large share of the traversal's time */
         cs_index_pairs found = w->found[t];
         found.n = 0;
         traversal tr = {A, B, A == B, rank, 0, NULL, &found, 0};

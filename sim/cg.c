@@ -81,8 +81,8 @@ static inline void sym_block_apply(const double a[6], const double r[3], double 
  * be inverted (it maps the tangent plane to itself, so the added normal
  * part never reaches a projected residual). Preconditioning with the
  * unfiltered block's inverse, projected after, mixed the normal row into
- * the tangent answer: on the 100 x 100 bench's contact solves the
- * filtered block takes 18-31 iterations where that took 27-37. */
+ * the tangent answer, and the contact solves took markedly more
+ * iterations. */
 static inline void system_block(const cs_sim *sim, int i, const double B[6], double a[6])
 {
     double m = sim->mass[i], hd = sim->half_dt;
@@ -153,9 +153,8 @@ void cs_system_apply(const cs_sim *sim, const double *v, double *out)
 /* The solve runs in one parallel region: its passes are worksharing loops
  * whose ends are barriers, and every thread sums the block partials
  * itself, in block order, so all hold the same scalars and take the same
- * branches. A region per pass cost a fork and a join each, about 4.5 us
- * in a run on this VM against 1.5 us for a barrier, 30 times a step at
- * 100 x 100. Messages (more than one rank) go through one thread, the
+ * branches. A region per pass would cost a fork and a join each, several
+ * times a barrier's cost, dozens of times a step. Messages (more than one rank) go through one thread, the
  * others waiting at the end of its single block. */
 
 /* Sums block partials in block order and over ranks (with the maximum of
@@ -215,11 +214,10 @@ static void forward_ghosts(cs_par *par, double *a)
  * last (the last's is 1 minus it). Table 1's damping is 15 times critical,
  * and the trapezoidal step turns a mode damped that hard into one whose
  * velocity flips sign from step to step, so the response two steps back
- * predicts those modes and the last one the smooth rest. Total CG
- * iterations, 48 frames of the 50 x 50 bench, at weights 0, 0.5, 0.75, 1:
- * 95,652, 84,137, 81,632, 83,174 (its damped-limit run: 80,002 at 0,
- * 73,510 at 0.75); the twisting cloth, 12 frames: 14,130 at 0, 14,193 at
- * 0.75. */
+ * predicts those modes and the last one the smooth rest. Of the weights
+ * 0, 0.5, 0.75 and 1, 0.75 took the fewest CG iterations on the benchmark
+ * sheet, at both step limits; on the twisting cloth the weight made no
+ * difference. */
 static const double WARM_BEFORE_WEIGHT = 0.75;
 
 /* v0 is read and v written where owned (y, the start, is sent to the
@@ -251,14 +249,10 @@ int cs_cg_solve(cs_sim *sim, const double *v0, const double *rhs, double *v, con
      * reach it). With base (B.5 gets B.1's response of the same step),
      * the history is of this solve's excess over base, and base is added:
      * B.1's response already holds what changed since the last step.
-     * Total CG iterations, B.5 predicted from its own history against
-     * from B.1's: 50 x 50 bench, 48 frames, 78,885 -> 53,837 (damped
-     * limit 67,648 -> 55,684); 100 x 100 damped, 24 frames, 98,824 ->
-     * 88,717; 200 x 200 damped, frames 1-8 17,740 -> 13,877 and the
-     * landing, frames 9-12, 102,857 -> 96,440. B.1
-     * predicted likewise from B.5 gained nothing (98,824 -> 98,689): the
-     * velocity is extrapolated between them (B.6), which flips the
-     * hardest-damped modes. The explicit update leaves the damping out so
+     * Predicting B.5 from B.1's response saves CG iterations at every size
+     * and both step limits against B.5's own history; B.1 predicted
+     * likewise from B.5 gained nothing: the velocity is extrapolated
+     * between them (B.6), which flips the hardest-damped modes. The explicit update leaves the damping out so
      * that it needs no pass over the springs: the one pass below takes the
      * residual and builds the block Jacobi preconditioner from the same
      * directions (two passes before; the warm start carries the damping). */
@@ -320,8 +314,7 @@ int cs_cg_solve(cs_sim *sim, const double *v0, const double *rhs, double *v, con
         /* Two passes an iteration: the direction's update p = y + beta p is
          * folded into the next operator pass, which applies A to y instead
          * and takes P A p = P A y + beta q (A and P are fixed within the
-         * solve); the third pass and its fork and join had 2% of a contact
-         * frame's samples (the first iteration applies A to p, which the
+         * solve), saving a third pass and its fork and join (the first iteration applies A to p, which the
          * setup pass made). */
         int it = 0;
         double beta = 0, pending = 0; /* pending: the last alpha, not yet in z */

@@ -155,7 +155,7 @@ static int next_body(const cs_body_grid *g, const int *unbounded, int nunbounded
  * meets that one too). A meeting changes only its own point, so the
  * threads share the points. This was a pass per body over lists of the
  * points in its box, built each step by two serial passes over every point
- * with the other threads waiting (3% of a contact frame at 100 x 100). */
+ * with the other threads waiting. */
 void cs_body_collide(cs_sim *sim, double dt)
 {
     int nb = sim->nbodies;

@@ -72,9 +72,9 @@ bool cs_plan_has(const cs_plan *plan, cs_stage stage)
 
 /* Peak resident bytes per particle of a run, measured on the sheet-and-ball
  * benchmark (Release, one thread, first frame; the difference between 60 x 60
- * and 120 x 120 quads): 4.6 kB with self-collision (BVH, pairs, history,
- * impact zones) and 2.0 kB without. Contacts and zones grow it later (the
- * 100 x 100 drape peaked 10% above its first frame), hence the margin. */
+ * and 120 x 120 quads), with self-collision (BVH, pairs, history, impact
+ * zones) and without, plus a margin: contacts and zones grow a run's memory
+ * after its first frame. */
 static const double BYTES_PER_PARTICLE_SELF = 6000.0, BYTES_PER_PARTICLE = 2500.0;
 
 double cs_sim_estimate_bytes(double particles, bool self_collision)

@@ -1,4 +1,4 @@
-/* runaway.c: instability detection (issue 12).
+/* runaway.c: instability detection.
  *
  * A blow-up of the explicit elastic forces, a solve gone astray or a
  * collision response that adds energy all show as cloth moving far faster

@@ -704,8 +704,8 @@ void cs_selfcol_find_pairs(cs_sim *sim, double span)
      * overlap. A pair must pass both the boxes and may_meet, so `path`
      * drops the pairs within may_meet's reach whose straight paths miss:
      * another rule, not only a faster search (the same frames on drapes,
-     * not on cloth folding onto itself; docs/performance-log.md, "Step
-     * A's boxes along the path").
+     * not on cloth folding onto itself; docs/performance.md, "Step A's
+     * boxes along the path").
      * Either way only relative motion widens a box: a sheet
      * falling rigidly needs no wider boxes than one at rest. A pair that
      * comes closer faster than that is step C's to catch. */

@@ -28,34 +28,30 @@
 
 /* The slack a rebuild grows each particle's box by, per thickness: wider
  * lives longer but holds more pairs to filter (measured on the 100 x 100
- * benchmark sheet; docs/performance-log.md, "Candidate pairs kept"). */
+ * benchmark sheet; docs/performance.md, "Step A's pair cache"). */
 static const double CACHE_SLACK_PER_THICKNESS = 0.5;
 /* A particle moving relative to the cloth, whose search box reaches m past
  * half the thickness around it (its motion over the span), gets m more
  * slack: it will have moved about as far by the next search. With the fixed slack alone
- * the falling rim of a sheet landing on a ball escaped at every outer step
- * (15-35% of the particles at 100 x 100, frame 11), so every search
- * rebuilt. A particle moving more than this many thicknesses a span gets
+ * the falling rim of a sheet landing on a ball escaped at every outer step,
+ * so every search rebuilt. A particle moving more than this many thicknesses a span gets
  * none: no slack it could use would keep its list short (the damped step
  * limit's long spans), and its neighbours' lists would grow for nothing.
- * 100 x 100 bench, 12 frames, step A (medians, alternated runs): default
- * step 13.3 -> 10.5 s (186 -> 101 traversals), damped limit 7.1 -> 7.5 s
- * (46 -> 44); the same frames, bit for bit. */
+ * The motion slack roughly halves step A's traversals at the default step
+ * and changes little at the damped limit; the frames are the same bits. */
 static const double CACHE_MOTION_SLACK_MAX = 2.0;
 /* The cache follows the cloth's centroid, but a sheet landing on a body
  * stops where it touches while the rest falls on: seen from the centroid,
  * the stopped part rises at the centroid's speed and left its grown box
- * within two or three outer steps (100 x 100 bench, landing frames 13-14:
- * 17 and 15 traversals a frame). So a rebuild also reaches each box along
+ * within two or three outer steps. So a rebuild also reaches each box along
  * the particle's motion relative to the centroid over this many of step
  * A's spans (its drift), a forecast that holds while the relative motion
- * does: 7 and 6 traversals there, step A 0.35 s less over the two frames
- * (medians of alternated runs), the same bits (the lists do not depend on
- * the cache). Where motion changes faster than a few spans, as in the
- * 200 x 200 landing at the damped step limit with `path` boxes (drift of
- * up to 14 mm a span, every other search rebuilding whatever the boxes),
- * longer boxes only add candidates: step A took 1.4 times as long there.
- * So the forecast is made only when the cache it replaces served at least
+ * does: about half the traversals in the landing frames, the same bits
+ * (the lists do not depend on the cache). Where motion changes faster
+ * than a few spans, as in the 200 x 200 landing at the damped step limit
+ * with `path` boxes (a drift of many millimetres a span, every other
+ * search rebuilding whatever the boxes), longer boxes only add candidates
+ * and make step A slower. So the forecast is made only when the cache it replaces served at least
  * CACHE_FORECAST_AFTER searches: the motion was steady enough for boxes to
  * last. */
 static const double CACHE_FORECAST_SPANS = 8.0;
@@ -90,8 +86,8 @@ static bool contained(const cs_selfcol *sc, const double T[3])
 /* ------------------------------------------------------------ the skin
  *
  * Step A's makers measure the exact distance of every pair whose boxes
- * overlap, and keep almost none: on the 100 x 100 bench sheet in free fall
- * about 70,000 a search, all of them farther than the thickness. As
+ * overlap, and keep almost none: on the benchmark sheet in free fall tens
+ * of thousands a search, all of them farther than the thickness. As
  * molecular dynamics does with a Verlet list's skin, the cache keeps each
  * pair's distance at the positions it was built from (x_ref), measured the
  * first time the pair is asked about; since then the distance changed by at

@@ -3,9 +3,9 @@
  *
  * Equal shares leave the faster thread waiting at every barrier when the
  * cores run at different speeds: a cloud VM's vCPUs when the host runs
- * something else on one of them (on the 2-vCPU build machine one thread
- * took twice as long as the other over whole frames, the other waiting
- * 40% of its time in libgomp), or big and little cores. So the split
+ * something else on one of them (one thread can take twice as long as the
+ * other over whole frames, the other waiting in libgomp), or big and
+ * little cores. So the split
  * follows the threads' measured speeds: each thread clocks its own part
  * of the heavy passes (CG's, the springs', B.5's damping pass), and after
  * each solve the shares move towards rows in proportion to rows per

@@ -292,7 +292,7 @@ typedef enum cs_script_zones {
                                    the summary reports) */
 } cs_script_zones;
 
-/* Step A's broad phase (docs/performance-log.md, "Step A's boxes along
+/* Step A's broad phase (docs/performance.md, "Step A's boxes along
  * the path"). */
 typedef enum cs_pair_pruning {
     CS_PRUNING_SPEED = 0, /* the paper's non-aggressive pruning: a particle's

@@ -238,11 +238,10 @@ static inline cs_pair2 pair2_sqrt(cs_pair2 a)
 }
 
 /* inv[k] = 1 / sqrt(uu[k]) where sqrt(uu[k]) > 0, else 0, for k < n (n
- * even): the elastic pass's square roots and divisions, a third of its
- * time (bench_cg_speed at 100 x 100, 2 threads: 213 us a pass, 150 with
- * them replaced by multiplications). The divider takes about as long for
- * 2, 4 or 8 lanes (1.74, 0.86 and 0.43 ns an entry on the AMD EPYC VM),
- * so the widest vectors the CPU has are chosen at run time. Square roots
+ * even): the elastic pass's square roots and divisions, a large part of
+ * its time (bench_cg_speed times the pass). The divider takes about as
+ * long for 2, 4 or 8 lanes, so the time an entry falls with the width, and
+ * the widest vectors the CPU has are chosen at run time. Square roots
  * and divisions are correctly rounded at any width: the same bits. */
 typedef void (*inv_lengths_fn)(const double *uu, double *inv, int n);
 
@@ -355,9 +354,8 @@ static void store_row_force(const cs_springs *s, int r, const cs_pair2 fr[3], do
  * most this many entries: their lengths first, then the divider's work
  * for the whole batch in one call, then the rest. Called per row, the wide
  * divisions of a row's dozen entries waited on each other and the pass
- * gained nothing; batched, it takes 0.84 times as long (bench_cg_speed,
- * 100 x 100, 2 threads, medians of 7 alternated runs: 212 -> 178.5 us),
- * 64 or 256 entries about the same. A row longer than a batch goes alone,
+ * gained nothing; batched, the divisions overlap and the pass is faster
+ * (bench_cg_speed), 64 or 256 entries about as fast as 128. A row longer than a batch goes alone,
  * in pieces. */
 enum { BATCH = 128 };
 

@@ -60,8 +60,8 @@ void cs_springs_free(cs_springs *s);
 /* Two row entries at a time, one per lane of GCC's two-double vector
  * (SSE2 on x86-64, NEON on AArch64): the spring kernels were bound by
  * scalar arithmetic, not memory (halving the directions' bytes with
- * floats gained nothing measurable; pairs took CG's setup pass 23% and
- * the damping pass 29% faster). A row sums its even and odd entries in
+ * floats gained nothing measurable; pairs made CG's setup pass and the
+ * damping pass markedly faster). A row sums its even and odd entries in
  * the two lanes and adds the lanes at the end: one fixed order at any
  * thread count. */
 typedef double cs_pair2 __attribute__((vector_size(16)));
@@ -76,8 +76,8 @@ static inline cs_pair2 cs_pair2_load(const double *p)
 /* u[d] = component d of the far ends of entries e and e + 1, less the
  * row's own. The ends' addresses are taken once, in pointer arithmetic, so
  * the three components are loads at fixed offsets (indexing with the int
- * 3 * other + d made GCC sign-extend each of the six: 12 of the CG
- * operator's 43 instructions per pair of entries). */
+ * 3 * other + d made GCC sign-extend each of the six, a good part of
+ * the CG operator's instructions). */
 static inline void cs_pair2_gather(const double *x, const int *other, int e, const double *own,
                                    cs_pair2 u[3])
 {

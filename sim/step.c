@@ -164,8 +164,8 @@ static void explicit_forces(cs_sim *sim, const double *x, const double *v_start,
 }
 
 /* Copies 3 doubles per particle over the given ranges, shared among the
- * threads (a serial copy left the other thread waiting: perf put 1.6% of
- * the 100 x 100 run's samples in it, all on the main thread). */
+ * threads (a serial copy left the other threads waiting, the copy all on
+ * the main thread). */
 static void copy_ranges(const int *ranges, int nranges, double *dst, const double *src)
 {
     CS_PARALLEL_FOR_RANGES(ranges, nranges, i)

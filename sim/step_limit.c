@@ -16,7 +16,8 @@
  * 1/l)) is not damped and bounds the step like an undamped spring: a
  * stretched cloth needs smaller steps than a slack one. (The condition was
  * checked numerically against the amplification matrix's eigenvalues for
- * random M, K and rank-deficient D; README, "The damped step limit".)
+ * random M, K and rank-deficient D; docs/accuracy.md, "The damped step
+ * limit".)
  *
  * The test used: drop the springs whose damping outweighs their stiffness
  * at this dt (removing a negative semi-definite term only raises the
@@ -32,8 +33,8 @@
  * The damped limit is a scene's choice (time.step_limit: damped), not the
  * default: steps far above the undamped limit are stable but less accurate
  * where friction and contact matter (the incline's analytic error grows
- * past its 0.1% tolerance at twice the default step; README, "The damped
- * step limit").
+ * past its 0.1% tolerance at twice the default step; docs/accuracy.md,
+ * "The damped step limit").
  */
 #include <math.h>
 #include <stdlib.h>

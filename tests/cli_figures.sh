@@ -1,6 +1,6 @@
 #!/bin/sh
 # cli_figures.sh CLOTHSIM_EXE SOURCE_DIR: every paper-figure scene of
-# scenes/figures/ (issue 13) runs at its test size through `clothsim run` as
+# scenes/figures/ runs at its test size through `clothsim run` as
 # a user would, and at EVERY frame (frames.jsonl and the frame's mesh) ends
 # with zero intersecting triangle pairs by the independent verifier, no NaN,
 # a largest speed within what the scene's physics can explain, and no point
@@ -170,7 +170,7 @@ figure spinning_ball 36 "$(python3 -c "import math; print(2 * (math.sqrt(2 * $G 
 # together times 1.5. 40 frames: flipped by 1.1 s, through the folds by 1.6 s.
 figure curtain_ball 40 "$(python3 -c "import math; print(1.5 * (math.hypot(0.25, 0.5) / 0.5 + math.sqrt(2 * $G * 1.0)))")" out_curtain
 
-# Fig. 15, wardrobe: another scene of issue 13, checked when it exists. Its
+# Fig. 15, wardrobe: checked when its scene exists. Its
 # motions are its own, so a generic bound: gravity over the run's time (1 s
 # at 24 fps) plus 3 m/s for scripted motion and wind, times 1.5.
 if [ -f "$FIG/wardrobe.yaml" ]; then

@@ -1,6 +1,6 @@
 #!/bin/sh
 # cli_mesh.sh CLOTHSIM_EXE SOURCE_DIR: mesh files and level sets from the
-# command line (issue 4): `clothsim mesh-info`, `clothsim levelset`, their
+# command line: `clothsim mesh-info`, `clothsim levelset`, their
 # errors (status 2, one clear line), and the shipped bunny scene, whose
 # frames must stay clear of the body (summary.json's body_penetration_max).
 # The meshes are in the repository's assets/ folder; without them this

@@ -1,6 +1,6 @@
 #!/bin/sh
 # cli_mesh_bad.sh CLOTHSIM_EXE SOURCE_DIR: no mesh file crashes or hangs a
-# command (issue 12). Every file of tests/data/bad_meshes/ through
+# command. Every file of tests/data/bad_meshes/ through
 # `clothsim mesh-info` (exit 2, one line naming the file and what is
 # wrong), bad files as a scene's body and cloth, a binary PLY that assimp
 # 5.2 misread read right by every reader, the units warning, and a cloth

@@ -1,5 +1,5 @@
 #!/bin/sh
-# cli_output.sh CLOTHSIM_EXE SOURCE_DIR: the output folder (issue 12).
+# cli_output.sh CLOTHSIM_EXE SOURCE_DIR: the output folder.
 # - Every write is checked: a file-size limit (ulimit -f: EFBIG) on a frame
 #   (written through assimp), on state.h5 (HDF5) and on frames.jsonl mid-run,
 #   and /dev/full (ENOSPC) on summary.json and state.h5, each exit 4 naming

@@ -3,7 +3,7 @@
 # take are refused at load with the reason (exit 2), a step above the
 # stability limit is warned about with the limit shown, and a run that blows
 # up is caught early, named with its frame and stage, and stops with exit 3
-# and the frames before it kept (issue 12).
+# and the frames before it kept.
 set -eu
 
 NAME=cli_stability

@@ -13,8 +13,8 @@ set -eu
 NAME=cli_sweep
 . "$2/tests/harness.sh"
 # One OpenMP thread per run: this tests what sweep measures, not threads,
-# and under ctest -j a team per run spins against the other tests (32 s
-# against 96 s of ASan wall time on a busy 2-core machine).
+# and under ctest -j a team per run spins against the other tests, which
+# makes this test several times slower on a busy machine.
 export OMP_NUM_THREADS=1
 
 cat >tiny.yaml <<'YAML'

@@ -1,6 +1,6 @@
 #!/bin/sh
-# cli_threads.sh CLOTHSIM_EXE SOURCE_DIR: OpenMP threads inside a rank
-# (issue 10). The same scene gives the same bits at 1, 2 and 3 threads:
+# cli_threads.sh CLOTHSIM_EXE SOURCE_DIR: OpenMP threads inside a rank.
+# The same scene gives the same bits at 1, 2 and 3 threads:
 # springs are gathered per particle in a fixed order, inner products are
 # summed in fixed blocks, collision candidates are joined in the traversal's
 # order. Hybrid runs (2 ranks of 1 thread against 1 rank of 2) agree as rank

@@ -3,8 +3,8 @@
 # run self-collision and body contact, on a build without sanitizers
 # (valgrind cannot run AddressSanitizer's). It sees what ASan cannot: reads
 # of memory never written (step C once read a history vector it had not
-# set, and results depended on leftovers; issue 12). Run by scripts/test.sh
-# after the suite. About 40 s on the 2-core build machine.
+# set, and results depended on leftovers). Run by scripts/test.sh
+# after the suite; it is kept to a few small scenes because valgrind is slow.
 set -eu
 
 NAME=memcheck

@@ -1,5 +1,5 @@
 /* test_friction_schedule.c: a body's friction that changes over time
- * (bodies[].friction_keys, issue 13).
+ * (bodies[].friction_keys).
  *
  * - cs_body_def_friction: piecewise linear between keys, constant outside,
  *   the constant `friction` without keys.

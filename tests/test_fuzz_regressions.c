@@ -1,4 +1,4 @@
-/* test_fuzz_regressions.c: every input the fuzzers of fuzz/ (issue 12)
+/* test_fuzz_regressions.c: every input the fuzzers of fuzz/
  * found to crash or hang, replayed through the normal code path. Each
  * file of tests/data/fuzz/scene/ is loaded with cs_scene_load (its
  * "#set PATH=VALUE" lines passed as overrides, as scene_fuzz does); each

@@ -1,4 +1,4 @@
-/* A value is validated against one definition (issue 11): the range of each
+/* A value is validated against one definition: the range of each
  * scene key lives in import/scene_keys.def, and the loader refuses a value
  * outside it with the file and line. The core checks the same values again
  * for programs that fill cs_sim_def themselves (sim knows no scene files);

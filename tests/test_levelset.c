@@ -1,4 +1,4 @@
-/* test_levelset.c: mesh bodies as OpenVDB level sets (issue 4).
+/* test_levelset.c: mesh bodies as OpenVDB level sets.
  *
  * - accuracy: phi of the grid against the exact signed distance to the
  *   triangle mesh, by brute force (closest point on every triangle; the

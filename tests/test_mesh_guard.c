@@ -1,6 +1,6 @@
 /* test_mesh_guard.c: the child process that reads mesh files
  * (import/mesh_guard.c): what a reader does to itself stays in the child
- * and comes back as a sentence, in bounded time and memory (issue 12). The
+ * and comes back as a sentence, in bounded time and memory. The
  * readers are stand-ins that crash, double-free, spin, allocate without
  * end or vanish, as assimp 5.2 did on corrupt files. */
 #include <setjmp.h>

@@ -3,7 +3,7 @@
  * folder, checked against the counts of its MANIFEST.md; node selection
  * and merging, units and placement; repairs and topology; hole closing; and
  * bad input, which must be a clear message, never a crash, a hang or an
- * empty mesh (issue 12: tests/data/bad_meshes/).
+ * empty mesh (tests/data/bad_meshes/).
  *
  * The meshes come from the repository's assets/ folder (CS_ASSETS_DIR);
  * without them the tests fail, they do not skip. */
@@ -401,7 +401,7 @@ static void test_bad_input(void **state)
 #error "CS_SOURCE_DIR must name the repository (tests/CMakeLists.txt defines it)"
 #endif
 
-/* tests/data/bad_meshes/: each file a case of issue 12 that crashed, hung,
+/* tests/data/bad_meshes/: each file a case that crashed, hung,
  * tried to allocate what its header claimed, or was silently misread. */
 static void test_bad_files(void **state)
 {

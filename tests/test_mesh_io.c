@@ -260,7 +260,7 @@ static void test_write_bad_input(void **state)
     assert_false(exists(path));
 }
 
-/* A cloth without triangles is written as points and read back (issue 12):
+/* A cloth without triangles is written as points and read back:
  * alone, a point-cloud PLY of vertices only; beside a triangle mesh, in
  * the same file. */
 static void test_points(void **state)

@@ -1,5 +1,5 @@
 /* test_mesh_roundtrip.c: every frame the project writes, it reads back
- * (issue 12). Random meshes (random sizes, point clouds among them, one to
+ * unchanged. Random meshes (random sizes, point clouds among them, one to
  * twelve per file; coordinates of random sign and magnitude, and in half of
  * the files a first coordinate whose first byte in a binary file is a
  * line feed, carriage return, space or tab, which assimp 5.2's PLY reader
@@ -214,8 +214,8 @@ static void test_roundtrip(void **state)
         random_file f;
         make_file(&f, i % 2 ? awkward[(i / 2) % 4] : 0);
         for (int fi = 0; fi < 3; fi++) {
-            /* assimp's OBJ reader costs 85 ms a file under AddressSanitizer
-             * (it clears a 16 MB buffer): a fifth of the files */
+            /* assimp's OBJ reader is slow under AddressSanitizer (it
+             * clears a 16 MB buffer a file): a fifth of the files */
             if (formats[fi] == CS_MESH_OBJ && i % 5 != 0)
                 continue;
             char path[512], err[1024] = "";

@@ -1,7 +1,7 @@
 /* test_scene.c: the YAML scene loader (import/scene_*.c, from the table of
  * keys import/scene_keys.def): values and defaults of a converted scene,
- * selections, files, the shipped scenes and the example in the README's
- * scene reference. Its error messages and --set overrides:
+ * selections, files, the shipped scenes and the example in
+ * docs/scene-reference.md. Its error messages and --set overrides:
  * test_scene_errors.c. */
 #include <stdarg.h>
 #include <stddef.h>
@@ -474,19 +474,19 @@ static void test_shipped_scenes(void **state)
     globfree(&g);
 }
 
-/* The complete example of the README's scene reference loads (the first yaml
- * block after the "### Complete example" heading), and the simulation
+/* The complete example of docs/scene-reference.md loads (the first yaml
+ * block after the "## Complete example" heading), and the simulation
  * accepts what it becomes. */
 static void test_reference_example(void **state)
 {
     (void)state;
-    FILE *f = fopen(CS_SOURCE_DIR "/README.md", "r");
+    FILE *f = fopen(CS_SOURCE_DIR "/docs/scene-reference.md", "r");
     assert_non_null(f);
     char line[1024], text[16384] = "";
     size_t used = 0;
     int phase = 0;   /* 0: before the heading, 1: before the fence, 2: in it */
     while (phase < 3 && fgets(line, sizeof line, f)) {
-        if (phase == 0 && !strncmp(line, "### Complete example", 20))
+        if (phase == 0 && !strncmp(line, "## Complete example", 19))
             phase = 1;
         else if (phase == 1 && !strncmp(line, "```yaml", 7))
             phase = 2;
@@ -508,7 +508,7 @@ static void test_reference_example(void **state)
     cs_scene_destroy(s);
 }
 
-/* ------------------------------------------ friction schedules (issue 13) */
+/* ---------------------------------------------------- friction schedules */
 
 /* bodies[].friction_keys: the keys as loaded, and no friction key beside. */
 static void test_friction_keys_loaded(void **state)

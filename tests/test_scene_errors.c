@@ -67,7 +67,7 @@ static void test_error_unknown_key(void **state)
                  0, NULL, "scenes/a.yaml:5: cloths[0].material.stiffness: unknown key");
     expect_error_after_grid("gravty: [0, -9.8, 0]\n",
                             "scenes/a.yaml:3: gravty: unknown key; did you mean gravity?");
-    /* the nearest known key is named (issue 11), a transposition counting once */
+    /* the nearest known key is named, a transposition counting once */
     expect_error("cloths:\n"
                  "  - grid:\n"
                  "      resolutoin: [2, 2]\n",

@@ -1,4 +1,4 @@
-/* test_scene_mesh.c: the scene keys of issue 4: cloths and bodies from mesh
+/* test_scene_mesh.c: the scene keys of mesh files: cloths and bodies from mesh
  * files (file, node, units, scale, rotation, translate), mesh bodies as
  * level sets (voxel_size, band, interior, close_holes), the cache
  * (levelset.cache), and one exact message per kind of error, each one line

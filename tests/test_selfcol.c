@@ -553,8 +553,8 @@ static void test_ball_pushes_through_folds(void **state)
 /* test_selfcol [--only PATTERN | --skip PATTERN]: the cases whose names
  * match cmocka's PATTERN (* and ? wildcards), or all but those. ctest runs
  * the two twisting strips and the rest as three entries side by side
- * (tests/CMakeLists.txt); in one they took 275 s of a 300 s timeout under
- * ASan. */
+ * (tests/CMakeLists.txt); in one they came close to its 300 s timeout
+ * under ASan. */
 int main(int argc, char **argv)
 {
     if (argc == 3 && strcmp(argv[1], "--only") == 0) {

@@ -1,4 +1,4 @@
-/* Every term of the model checked on its own (issue 14, item 4): each test
+/* Every term of the model checked on its own: each test
  * isolates one physical term in a scene small enough to have an analytic
  * answer, or a reference computed here independently of sim/ (a Newton
  * solve of the static equilibrium from the spring law, the closed form of

@@ -1,4 +1,4 @@
-/* Every term of the model checked on its own (issue 14, item 4): the
+/* Every term of the model checked on its own: the
  * self-collision terms of Section 5, each in a scene of one or two pairs
  * whose response has a closed form: Eq. 1's elastic repulsion in both of
  * its branches, the inelastic repulsion, cloth-cloth Coulomb friction as

@@ -1,4 +1,4 @@
-/* Every term of the model checked on its own (issue 14, item 4): the wind
+/* Every term of the model checked on its own: the wind
  * of Section 8 (velocity drag, the ground boost, the gust field, a sheet
  * driven by a gust), each against a closed form. The other terms are in
  * test_terms.c, with the table of mutations these files catch. */
@@ -112,7 +112,8 @@ static void test_wind_ground_boost(void **state)
 /* The gust field (wind.gust, an ABC flow), checked from its definition:
  * divergence-free (central differences), each component's RMS over a
  * wavelength cube equal to `gust`, never faster than cs_wind_max_speed, and
- * changing with time at the rates the README gives (one phase a period). */
+ * changing with time at the rates docs/scene-reference.md gives (one phase
+ * a period). */
 static void test_wind_gust_field(void **state)
 {
     (void)state;
