@@ -1,6 +1,7 @@
 #!/bin/sh
 # cli_scene_reference.sh CLOTHSIM_EXE SOURCE_DIR: README.md's scene reference
-# tables are the ones `clothsim help scene --markdown` prints from the table
+# tables (and those of docs/input-check.md, the `check` section's) are the
+# ones `clothsim help scene --markdown` prints from the table
 # of keys (import/scene_keys.def), block by block between the
 # <!-- scene-reference:begin SECTION --> and end markers (issue 11); and
 # `clothsim help scene` prints the reference, an unknown key names the
@@ -26,11 +27,14 @@ run 0 help scene --markdown
 cp out.txt generated.md
 blocks generated.md generated || fail "the generated reference has an unterminated block"
 blocks "$2/README.md" readme || fail "README.md has an unterminated scene-reference block"
+blocks "$2/docs/input-check.md" readme ||
+    fail "docs/input-check.md has an unterminated scene-reference block"
 [ -n "$(ls generated)" ] || fail "help scene --markdown printed no block"
 if ! diff -r -u readme generated >diff.txt; then
     cat diff.txt >&2
     fail "README.md's scene reference differs from 'clothsim help scene --markdown' \
-(import/scene_keys.def); paste that command's blocks into README.md"
+(import/scene_keys.def); paste that command's blocks into README.md and docs/input-check.md \
+(scripts/update-scene-reference.py does)"
 fi
 
 # the text form names every section and key
