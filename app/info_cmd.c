@@ -133,12 +133,6 @@ static double *scene_masses(const cs_scene *scene, int *nv_out)
 
 /* ------------------------------------------------------------------ plot */
 
-static int plplot_exit(const char *message)
-{
-    fprintf(stderr, "clothsim info: PLplot: %s\n", message);
-    return 1;
-}
-
 static void range_of(const double *y, int n, double *lo, double *hi)
 {
     *lo = INFINITY;
@@ -247,17 +241,10 @@ static int fill_plot(const char *tmp, void *vctx, char *why, size_t whylen)
         vs[i] = r->max_speed;
         fd[i] = r->fd_speed;
     }
-    plsexit(plplot_exit);
-    if (!cs_plot_has_pngcairo()) {
+    if (cs_plot_open(tmp, 900, 1100, why, whylen) != 0) {
         free(buf);
-        snprintf(why, whylen, "PLplot has no pngcairo device (install plplot-driver-cairo)");
         return -1;
     }
-    plsdev("pngcairo");
-    plsfnam(tmp);
-    plspage(0, 0, 900, 1100, 0, 0);
-    plscolbg(255, 255, 255);
-    plscol0(15, 0, 0, 0);
     plssub(1, 3);
     plinit();
     const double *y1[] = {pairs};
