@@ -4,6 +4,8 @@
  * own file (run.c, render_cmd.c, ...). A new command, or a help topic
  * (`clothsim help scene`: a row with topic set), is a new row. */
 #include "app/cli.h"
+#include "app/info_cmd.h"
+#include "app/input_check.h"
 #include "app/intersections_cmd.h"
 #include "app/help_cmd.h"
 #include "app/mesh_cmds.h"
@@ -29,6 +31,12 @@ static const cs_command COMMANDS[] = {
     {.name = "sweep", .synopsis = "sweep SCENE",
      .summary = "run a scene over settings; cost and error against a reference",
      .main = cs_sweep_main, .help = cs_sweep_help},
+    {.name = "check", .synopsis = "check SCENE",
+     .summary = "find intersections and other problems of a scene's start",
+     .main = cs_check_main, .help = cs_check_help},
+    {.name = "info", .synopsis = "info DIR",
+     .summary = "a run's frames as a table (pairs, energy, speed) and DIR/info.png",
+     .main = cs_info_main, .help = cs_info_help},
     {.name = "render", .synopsis = "render TARGET",
      .summary = "render a run's frames (or a scene's start) to PNG images",
      .main = cs_render_main, .help = cs_render_help},

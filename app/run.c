@@ -12,6 +12,7 @@
 
 #include "app/checkpoint.h"
 #include "app/cli.h"
+#include "app/input_check.h"
 #include "app/outdir.h"
 #include "app/progress.h"
 #include "app/scene_render.h"
@@ -679,18 +680,12 @@ int cs_run_main(int argc, char **argv)
         goto done;
     }
 
-    /* The verifier counts at each frame's end; a cloth that already
-     * intersects at the start (cloths placed through each other) would show
-     * as pairs at frame 1 with no word of why, and history-based collisions
-     * keep such pairs rather than separate them. */
-    if (root && !o.resume && scene->def.self_collision && scene->def.self.verify) {
-        long start_pairs = cs_sim_count_intersections(r.sim);
-        if (start_pairs > 0)
-            fprintf(stderr,
-                    "clothsim: warning: %s: the cloth starts with %ld intersecting triangle "
-                    "pairs; self-collision keeps them (it prevents crossings, it does not "
-                    "undo them): move the cloths apart\n",
-                    scene->path, start_pairs);
+    /* The start's intersections and other problems (app/input_check.c):
+     * an intersecting start is refused unless the scene accepts it. */
+    if (!o.resume) {
+        status = root ? cs_input_check_start(scene, o.quiet, stderr) : CS_EXIT_OK;
+        if ((status = cs_sim_agree(r.sim, status)) != CS_EXIT_OK)
+            goto done;
     }
 
     int ncloths = cs_sim_cloth_count(r.sim);

@@ -47,6 +47,12 @@ int cs_sweep_plot(const char *path, const cs_sweep_figure *figure, char *err, si
  * a device on the terminal); also bench/scaling_plot.c's check. */
 bool cs_plot_has_pngcairo(void);
 
+/* Before plinit: PLplot's pngcairo device onto the file tmp, width x height
+ * pixels, black on white, and a message instead of exit() on PLplot's
+ * fatal errors. Returns 0, or -1 with why (no pngcairo device). Also
+ * `clothsim info`'s figure (info_cmd.c). */
+int cs_plot_open(const char *tmp, int width, int height, char *why, size_t whylen);
+
 /* A table of text cells (row-major; "" not applicable), written atomically
  * as CSV (fields with commas quoted) or as a Markdown table ("" shown as
  * "–"). Returns 0, or -1 with err (sweep_report.c). */

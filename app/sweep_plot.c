@@ -14,7 +14,7 @@
 /* PLplot calls this instead of exit() on an error it cannot go on from. */
 static int plplot_exit(const char *message)
 {
-    fprintf(stderr, "clothsim sweep: PLplot: %s\n", message);
+    fprintf(stderr, "clothsim: PLplot: %s\n", message);
     return 1; /* let PLplot abort: nothing else can be done */
 }
 
@@ -68,6 +68,21 @@ bool cs_plot_has_pngcairo(void)
         if (strcmp(devs[i], "pngcairo") == 0)
             return true;
     return false;
+}
+
+int cs_plot_open(const char *tmp, int width, int height, char *why, size_t whylen)
+{
+    plsexit(plplot_exit);
+    if (!cs_plot_has_pngcairo()) { /* PLplot would ask on the terminal */
+        snprintf(why, whylen, "PLplot has no pngcairo device (install plplot-driver-cairo)");
+        return -1;
+    }
+    plsdev("pngcairo");
+    plsfnam(tmp);
+    plspage(0, 0, width, height, 0, 0);
+    plscolbg(255, 255, 255);
+    plscol0(BLACK, 0, 0, 0); /* black axes on white */
+    return 0;
 }
 
 /* Whether the axis point (x, y), scaled to [0,1]^2 of the box lo..hi,
@@ -178,16 +193,8 @@ static int fill_plot(const char *tmp, void *ctx, char *why, size_t whylen)
     axis_range(&xmin, &xmax, f->log_x);
     axis_range(&ymin, &ymax, f->log_y);
 
-    plsexit(plplot_exit);
-    if (!cs_plot_has_pngcairo()) { /* PLplot would ask on the terminal */
-        snprintf(why, whylen, "PLplot has no pngcairo device (install plplot-driver-cairo)");
+    if (cs_plot_open(tmp, 900, 640, why, whylen) != 0)
         return -1;
-    }
-    plsdev("pngcairo");
-    plsfnam(tmp);
-    plspage(0, 0, 900, 640, 0, 0);
-    plscolbg(255, 255, 255);
-    plscol0(BLACK, 0, 0, 0); /* black axes on white */
     plinit();
     plcol0(BLACK);
     /* 10: log x, 20: log y, 30: both; 0: linear */

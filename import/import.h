@@ -314,6 +314,8 @@ typedef struct cs_scene {
     int nnotes;                /* what import did and warnings, one line each,
                                   for the user ("warning: " first if one) */
     char **notes;
+    bool allow_intersecting_start; /* check.allow_intersecting_start: `run`
+                                      starts from intersecting cloth */
 } cs_scene;
 
 /* Loads and validates a scene file, then applies command-line overrides,

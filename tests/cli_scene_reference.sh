@@ -1,6 +1,7 @@
 #!/bin/sh
 # cli_scene_reference.sh CLOTHSIM_EXE SOURCE_DIR: docs/scene-reference.md's
-# tables are the ones `clothsim help scene --markdown` prints from the table
+# tables (and those of docs/input-check.md, the `check` section's) are the
+# ones `clothsim help scene --markdown` prints from the table
 # of keys (import/scene_keys.def), block by block between the
 # <!-- scene-reference:begin SECTION --> and end markers; and
 # `clothsim help scene` prints the reference, an unknown key names the
@@ -25,12 +26,16 @@ blocks() {
 run 0 help scene --markdown
 cp out.txt generated.md
 blocks generated.md generated || fail "the generated reference has an unterminated block"
-blocks "$2/docs/scene-reference.md" readme || fail "docs/scene-reference.md has an unterminated scene-reference block"
+blocks "$2/docs/scene-reference.md" readme ||
+    fail "docs/scene-reference.md has an unterminated scene-reference block"
+blocks "$2/docs/input-check.md" readme ||
+    fail "docs/input-check.md has an unterminated scene-reference block"
 [ -n "$(ls generated)" ] || fail "help scene --markdown printed no block"
 if ! diff -r -u readme generated >diff.txt; then
     cat diff.txt >&2
     fail "docs/scene-reference.md differs from 'clothsim help scene --markdown' \
-(import/scene_keys.def); paste that command's blocks into it (scripts/update-scene-reference.py)"
+(import/scene_keys.def); paste that command's blocks into docs/scene-reference.md and \
+docs/input-check.md (scripts/update-scene-reference.py does)"
 fi
 
 # the text form names every section and key
