@@ -26,7 +26,7 @@ assert "no collision-free state follows the scripts" in s["error"], s["error"]
 assert s["script_zones"] == "follow"
 PY
 
-run 0 run "$SCENE" -o held -q --frames 4 --set self_collision.script_zones=hold
+run 0 run "$SCENE" -o held -q --frames 2 --set self_collision.script_zones=hold
 python3 - held <<'PY' || fail "the held scripts' lag is not reported"
 import json, sys
 d = sys.argv[1]
