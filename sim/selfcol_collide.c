@@ -428,6 +428,16 @@ static void hold_script(cs_sim *sim, int s, double span)
     sim->script_lag[s] = held_lag;
 }
 
+/* Zone root's particles into sc->zone_list; returns how many. */
+static int zone_members(cs_selfcol *sc, int root)
+{
+    int count = 0;
+    for (int i = 0; i < sc->n; i++)
+        if (sc->zone[i] >= 0 && sc_zone_find(sc->zone, i) == root)
+            sc->zone_list[count++] = i;
+    return count;
+}
+
 /* A zone no end state could follow its scripts in: its size, scripts and
  * where (step C then stops the run, CS_ERR_SCRIPT). */
 static void note_conflict(cs_sim *sim, const int *list, int count)
@@ -479,10 +489,7 @@ static bool move_zones(cs_sim *sim, double span, double *dv)
     for (int root = 0; root < n; root++) {
         if (sc->zone[root] < 0 || sc_zone_find(sc->zone, root) != root)
             continue;
-        int count = 0;
-        for (int i = 0; i < n; i++)
-            if (sc->zone[i] >= 0 && sc_zone_find(sc->zone, i) == root)
-                sc->zone_list[count++] = i;
+        int count = zone_members(sc, root);
         double vcm[3], w[3];
         bool spans = zone_spans_scripts(sim, sc->zone_list, count);
         if (spans && follow) {
@@ -703,12 +710,17 @@ long cs_selfcol_collide(cs_sim *sim, double span, int k, bool detect_only)
              * rather than loop forever, the scripts too (their clocks
              * wait) */
             if (sc->stats.projected_zones > projected_before && sc->nkc > 0) {
-                int count = 0;
-                for (int i = 0; i < n; i++)
-                    if (sc->zone[i] >= 0 &&
-                        sc_zone_find(sc->zone, i) == sc_zone_find(sc->zone, sc->kc[0].v[0]))
-                        sc->zone_list[count++] = i;
-                memcpy(sc->conflict.where, x + 3 * sc->kc[0].v[3], sizeof sc->conflict.where);
+                /* name a zone that spans scripts: the first constraint's
+                 * zone may be a rigid one */
+                int j = 0, count = 0;
+                for (; j < sc->nkc; j++) {
+                    count = zone_members(sc, sc_zone_find(sc->zone, sc->kc[j].v[0]));
+                    if (zone_spans_scripts(sim, sc->zone_list, count))
+                        break;
+                }
+                if (j == sc->nkc) /* none spans now: the first one, then */
+                    count = zone_members(sc, sc_zone_find(sc->zone, sc->kc[j = 0].v[0]));
+                memcpy(sc->conflict.where, x + 3 * sc->kc[j].v[3], sizeof sc->conflict.where);
                 sc->conflict.shortfall = 0;
                 note_conflict(sim, sc->zone_list, count);
                 break;
