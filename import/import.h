@@ -190,18 +190,21 @@ typedef struct cs_levelset_request {
                                   mesh file's stem */
 } cs_levelset_request;
 
+#define CS_LEVELSET_KEY_LEN 33    /* 32 hex digits and the NUL */
+
 typedef struct cs_levelset_result {
     cs_levelset *grid;
     bool from_cache;           /* read from cache_path */
     char cache_path[1024];     /* the .vdb read or written; "" if none */
     char cache_note[512];      /* why the cache could not be used, or "" */
-    char key[65];              /* SHA-256 of everything the grid depends on */
+    char key[CS_LEVELSET_KEY_LEN]; /* XXH3-128 of everything the grid depends on,
+                                     in hex; "" if it could not be computed */
     double seconds;            /* converting or reading */
 } cs_levelset_result;
 
 /* The grid of a mesh (in its own frame): read from the cache when a file
  * there was made from the same mesh (after placement and repairs), voxel
- * size, band and OpenVDB version, keyed by the SHA-256 of them; otherwise
+ * size, band and OpenVDB version, keyed by the XXH3-128 hash of them; otherwise
  * converted and written there. A cache that cannot be read or written is
  * a note, not an error. */
 int cs_levelset_build(const cs_trimesh *mesh, const cs_levelset_request *req,

@@ -4,7 +4,7 @@
  * The cache holds .vdb files, which other tools open (OpenVDB's vdb_print,
  * Houdini, Blender). A file is named <label>-<first 16 hex digits of the
  * key>.vdb and carries the whole key as grid metadata "clothsim_key"; the
- * key is the SHA-256 of the mesh as OpenVDB receives it (32-bit float
+ * key is the XXH3-128 hash of the mesh as OpenVDB receives it (32-bit float
  * coordinates after placement and repairs, triangle indices), the voxel
  * size, band, interior fill and the OpenVDB version. So a grid is reused
  * exactly when it would come out the same, whatever the files' times. */
@@ -12,7 +12,6 @@
 
 #include "common/util.h"
 
-#include "import/sha256.h"
 
 #include <errno.h>
 #include <math.h>
@@ -22,6 +21,7 @@
 #include <string.h>
 #include <sys/stat.h>
 #include <unistd.h>
+#include <xxhash.h>
 
 /* ------------------------------------------------------------ sizes */
 
@@ -163,16 +163,22 @@ char *cs_levelset_cache_dir(const char *setting, const char *base_dir)
     return join(base, ".clothsim-cache");
 }
 
-static void compute_key(const cs_trimesh *mesh, const cs_levelset_request *req, char key[65])
+/* Files of an older key (SHA-256 named) simply never match a name. */
+static void compute_key(const cs_trimesh *mesh, const cs_levelset_request *req,
+                        char key[CS_LEVELSET_KEY_LEN])
 {
-    cs_sha256 h;
+    key[0] = '\0';
+    XXH3_state_t *h = XXH3_createState();
+    if (!h || XXH3_128bits_reset(h) != XXH_OK) {
+        XXH3_freeState(h);
+        return; /* no key: the cache is not used (an empty name never matches) */
+    }
     char head[256];
-    cs_sha256_init(&h);
-    int n = snprintf(head, sizeof head, "clothsim level set 1\nopenvdb %s\nvoxel %.17g\nband %.17g\n"
+    int n = snprintf(head, sizeof head, "clothsim level set 2\nopenvdb %s\nvoxel %.17g\nband %.17g\n"
                                         "fill %d\nvertices %d\ntriangles %d\n",
                      cs_levelset_library_version(), req->voxel_size, req->band,
                      req->fill_interior ? 1 : 0, mesh->nv, mesh->nt);
-    cs_sha256_update(&h, head, (size_t)n);
+    XXH3_128bits_update(h, head, (size_t)n);
     /* what OpenVDB receives: 32-bit floats, little-endian as on every
      * machine this runs on */
     float buf[3 * 256];
@@ -180,13 +186,17 @@ static void compute_key(const cs_trimesh *mesh, const cs_levelset_request *req, 
         int m = mesh->nv - i < 256 ? mesh->nv - i : 256;
         for (int k = 0; k < 3 * m; k++)
             buf[k] = (float)mesh->x[3 * i + k];
-        cs_sha256_update(&h, buf, 3 * (size_t)m * sizeof *buf);
+        XXH3_128bits_update(h, buf, 3 * (size_t)m * sizeof *buf);
     }
     for (int t = 0; t < 3 * mesh->nt; t++) {
         int32_t v = (int32_t)mesh->tri[t];
-        cs_sha256_update(&h, &v, sizeof v);
+        XXH3_128bits_update(h, &v, sizeof v);
     }
-    cs_sha256_hex(&h, key);
+    XXH128_canonical_t c;
+    XXH128_canonicalFromHash(&c, XXH3_128bits_digest(h));
+    XXH3_freeState(h);
+    for (size_t i = 0; i < sizeof c.digest; i++)
+        snprintf(key + 2 * i, 3, "%02x", c.digest[i]);
 }
 
 /* The label made safe for a file name. */
@@ -208,7 +218,7 @@ int cs_levelset_build(const cs_trimesh *mesh, const cs_levelset_request *req,
     memset(res, 0, sizeof *res);
     compute_key(mesh, req, res->key);
     double t0 = cs_now();
-    if (req->cache_dir) {
+    if (req->cache_dir && res->key[0]) {
         char label[64];
         safe_label(req->label, label, sizeof label);
         snprintf(res->cache_path, sizeof res->cache_path, "%s/%s-%.16s.vdb", req->cache_dir,
@@ -230,7 +240,7 @@ int cs_levelset_build(const cs_trimesh *mesh, const cs_levelset_request *req,
     if (!res->grid)
         return strstr(err ? err : "", "out of memory") ? CS_IMPORT_NOMEM : CS_IMPORT_BAD_INPUT;
     res->seconds = cs_now() - t0;
-    if (req->cache_dir) {
+    if (req->cache_dir && res->key[0]) {
         char why[400], voxel[32];
         snprintf(voxel, sizeof voxel, "%.17g", req->voxel_size);
         const char *keys[] = {"clothsim_key", "clothsim_source", "clothsim_voxel_size"};

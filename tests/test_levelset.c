@@ -9,8 +9,8 @@
  *   sphere's height within a voxel, and friction holds it or lets it slide
  *   as on the analytic sphere;
  * - the cache: a .vdb written, read back, reused by its content key, and
- *   replaced when the mesh or the voxel size change;
- * - SHA-256 against FIPS 180-4's test vectors.
+ *   replaced when the mesh or the voxel size change, and a file of the
+ *   older naming (a SHA-256 key) in the cache ignored.
  *
  * The meshes come from the repository's assets/ folder (CS_ASSETS_DIR);
  * without them the tests fail, they do not skip.
@@ -29,7 +29,6 @@
 #include <unistd.h>
 
 #include "import/import.h"
-#include "import/sha256.h"
 
 #ifndef CS_ASSETS_DIR
 #error "CS_ASSETS_DIR must name the repository's assets/ folder (tests/CMakeLists.txt defines it)"
@@ -484,6 +483,23 @@ static void test_cache(void **state)
     assert_int_equal(strncmp(r1.cache_path, dir, strlen(dir)), 0);
     struct stat st;
     assert_int_equal(stat(r1.cache_path, &st), 0);
+    /* the key: XXH3-128 in hex, its first 16 digits in the file's name */
+    assert_int_equal(strlen(r1.key), 32);
+    assert_int_equal(strspn(r1.key, "0123456789abcdef"), 32);
+    char name[64];
+    snprintf(name, sizeof name, "/ico4-%.16s.vdb", r1.key);
+    assert_non_null(strstr(r1.cache_path, name));
+    /* a grid under an older name (the SHA-256 key's) is simply not looked at */
+    char old[400];
+    snprintf(old, sizeof old, "%s/ico4-%.16s.vdb", dir, "9f86d081884c7d65");
+    assert_int_equal(rename(r1.cache_path, old), 0);
+    cs_levelset_result r0;
+    assert_int_equal(cs_levelset_build(m, &req, &r0, err, sizeof err), CS_IMPORT_OK);
+    assert_false(r0.from_cache);
+    assert_string_equal(r0.cache_note, "");
+    assert_string_equal(r0.cache_path, r1.cache_path);
+    cs_levelset_destroy(r0.grid);
+    unlink(old);
 
     /* the same input: read back, equal values */
     assert_int_equal(cs_levelset_build(m, &req, &r2, err, sizeof err), CS_IMPORT_OK);
@@ -574,40 +590,9 @@ static void test_voxel_checks(void **state)
     cs_trimesh_destroy(m);
 }
 
-static void test_sha256(void **state)
-{
-    (void)state;
-    static const struct {
-        const char *msg, *hex;
-    } vectors[] = {
-        {"", "e3b0c44298fc1c149afbf4c8996fb92427ae41e4649b934ca495991b7852b855"},
-        {"abc", "ba7816bf8f01cfea414140de5dae2223b00361a396177a9cb410ff61f20015ad"},
-        {"abcdbcdecdefdefgefghfghighijhijkijkljklmklmnlmnomnopnopq",
-         "248d6a61d20638b8e5c026930c3e6039a33ce45964ff2167f6ecedd419db06c1"},
-    };
-    for (size_t i = 0; i < sizeof vectors / sizeof *vectors; i++) {
-        cs_sha256 h;
-        char hex[65];
-        cs_sha256_init(&h);
-        cs_sha256_update(&h, vectors[i].msg, strlen(vectors[i].msg));
-        cs_sha256_hex(&h, hex);
-        assert_string_equal(hex, vectors[i].hex);
-    }
-    /* a million 'a', fed in uneven pieces */
-    cs_sha256 h;
-    char hex[65], chunk[997];
-    memset(chunk, 'a', sizeof chunk);
-    cs_sha256_init(&h);
-    for (int left = 1000000; left > 0; left -= (int)sizeof chunk)
-        cs_sha256_update(&h, chunk, left < (int)sizeof chunk ? (size_t)left : sizeof chunk);
-    cs_sha256_hex(&h, hex);
-    assert_string_equal(hex, "cdc76e5c9914fb9281a1c7e284d73e67f1809a48a497200e046d39ccc7112cd0");
-}
-
 int main(void)
 {
     const struct CMUnitTest tests[] = {
-        cmocka_unit_test(test_sha256),
         cmocka_unit_test(test_accuracy_sphere),
         cmocka_unit_test(test_gradient_sphere),
         cmocka_unit_test(test_accuracy_bunny),
