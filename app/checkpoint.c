@@ -64,6 +64,8 @@ int cs_run_identity_init(cs_run_identity *id, const char *scene_file, int noverr
     id->overrides = overrides;
     id->format = format;
     id->particles = cs_sim_particle_count(sim);
+    id->resolved = scene->resolved_setup;
+    id->resolved_len = scene->resolved_setup_len;
     id->scene_text = cs_file_read_all(scene_file, &id->scene_len);
     if (!id->scene_text) {
         snprintf(err, errlen, "cannot read %s: %s", scene_file, strerror(errno));
@@ -207,12 +209,16 @@ static int write_contents(hid_t f, const cs_run_identity *id, int frame, const c
         bad = doubles_write(f, path, a[k].data, a[k].count);
     }
 
-    hid_t text = string_type(id->scene_len);
     hsize_t one = 1;
-    bad = bad || text < 0 ||
-          dataset_write(f, "/scene/text", text, text, 0, &one, id->scene_text) != 0;
-    if (text >= 0)
-        H5Tclose(text);
+    const char *texts[] = {id->scene_text, id->resolved};
+    size_t lens[] = {id->scene_len, id->resolved_len};
+    const char *names[] = {"/scene/text", "/scene/resolved"};
+    for (int k = 0; k < 2; k++) {
+        hid_t text = string_type(lens[k]);
+        bad = bad || text < 0 || dataset_write(f, names[k], text, text, 0, &one, texts[k]) != 0;
+        if (text >= 0)
+            H5Tclose(text);
+    }
     /* fixed-length strings: variable-length ones go through HDF5's type
      * conversion, which callocs a megabyte per write (most of the cost of
      * a small checkpoint) */
@@ -455,14 +461,31 @@ static int compare_identity(hid_t f, const char *path, const cs_run_identity *id
         return CS_EXIT_OUTPUT;
     }
     int line = 0;
-    char now[128], then[128];
+    char now[128], then[128], scene_file[1024] = "";
+    attr_read_string(f, "scene_file", scene_file, sizeof scene_file);
+    /* the resolved scenes tell whether the run is the same (a run folder's
+     * scene.yaml against the file and overrides it came from); a state
+     * written before them has none, and the file and overrides decide */
+    size_t width2;
+    char *resolved = strings_read(f, "/scene/resolved", &one, &width2);
+    size_t rlen = resolved ? strnlen(resolved, width2) : 0;
+    bool same_resolved = resolved && id->resolved &&
+                         !first_difference(id->resolved, id->resolved_len, resolved, rlen, &line,
+                                           now, then, sizeof now);
+    bool same_file = !resolved || (!id->own_scene && strcmp(scene_file, id->scene_file) == 0);
     const char *gone = missing_override((const char *const *)over, nover, id->overrides,
                                         id->noverrides);
     const char *added = missing_override(id->overrides, id->noverrides,
                                          (const char *const *)over, nover);
     int rc = CS_EXIT_INPUT;
-    if (first_difference(id->scene_text, id->scene_len, text, len, &line, now, then,
-                         sizeof now))
+    if (same_resolved)
+        gone = added = NULL;
+    if (!same_resolved && !same_file)
+        snprintf(err, errlen, "cannot resume from %s: %s:%d: the resolved scene differs from "
+                 "the run's: now %s, then %s", path, id->scene_file, line, now, then);
+    else if (!same_resolved &&
+             first_difference(id->scene_text, id->scene_len, text, len, &line, now, then,
+                              sizeof now))
         snprintf(err, errlen, "cannot resume from %s: %s:%d: the scene file changed since the "
                  "run began: now %s, then %s", path, id->scene_file, line, now, then);
     else if (gone)
@@ -471,8 +494,8 @@ static int compare_identity(hid_t f, const char *path, const cs_run_identity *id
     else if (added)
         snprintf(err, errlen, "cannot resume from %s: --set %s was not given when the run "
                  "began", path, added);
-    else if (!same_override_order(id->overrides, id->noverrides, (const char *const *)over,
-                                  nover))
+    else if (!same_resolved && !same_override_order(id->overrides, id->noverrides,
+                                                    (const char *const *)over, nover))
         snprintf(err, errlen, "cannot resume from %s: the --set overrides are given in another "
                  "order than when the run began (a later one wins)", path);
     else if (strcmp(format, id->format) != 0)
@@ -485,8 +508,14 @@ static int compare_identity(hid_t f, const char *path, const cs_run_identity *id
         snprintf(err, errlen, "cannot resume from %s: the scene's initial state (positions, "
                  "velocities, masses, step or a body's mesh) differs from the run's although "
                  "its text and overrides do not: did a mesh file it reads change?", path);
+    else if (!same_resolved && resolved && id->resolved &&
+             first_difference(id->resolved, id->resolved_len, resolved, rlen, &line, now, then,
+                              sizeof now))
+        snprintf(err, errlen, "cannot resume from %s: the resolved scene differs from the "
+                 "run's at line %d: now %s, then %s", path, line, now, then);
     else
         rc = 0;
+    free(resolved);
     free(text);
     free(over);
     return rc;

@@ -9,6 +9,8 @@
  *   /state/cg/warm_half, /state/cg/warm_full_less_half,
  *   /state/cg/warm_half_before, /state/cg/warm_full_less_half_before, /state/self_collision/x_free
  *   /scene/text        the scene file's bytes when the run began
+ *   /scene/resolved    the resolved scene without time.frames (what a run
+ *                      from DIR/scene.yaml compares)
  *   /scene/overrides   its --set overrides, as given
  *   /run/totals        stage times and counts to carry the summary on
  *   attributes of /: format "clothsim state", format_version, frame,
@@ -35,6 +37,9 @@ typedef struct cs_run_identity {
     int noverrides;                  /* --set, as given; time.frames ones may */
     const char *const *overrides;    /* differ when resuming */
     const char *format;              /* "ply", "obj", "glb" */
+    const char *resolved;            /* cs_scene.resolved_setup (the scene's) */
+    size_t resolved_len;
+    bool own_scene;                  /* scene_file is the run folder's scene.yaml */
     int particles;
     /* XXH3-128 of the particle count, the step, and the initial positions,
      * velocities and masses: what the scene's text does not show (mesh
@@ -63,7 +68,8 @@ int cs_checkpoint_write(const char *path, const cs_run_identity *id, int frame,
                         size_t errlen);
 
 /* Rank 0: reads path, refuses it unless the run is made from the same
- * identity (the difference named in err), and writes its state into sim's
+ * identity (the difference named in err): the same resolved scene (but for
+ * time.frames), or else the same scene file and overrides, and writes its state into sim's
  * arrays (cs_sim_state_scatter then gives them to every rank). *frame: the
  * frame it was written after; totals: CS_SUMMARY_TOTALS doubles. Returns 0,
  * CS_EXIT_INPUT (nothing to resume, or not the same run) or CS_EXIT_OUTPUT

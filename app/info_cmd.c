@@ -458,7 +458,7 @@ int cs_info_main(int argc, char **argv)
         x = tmp;
     }
 
-    printf("run %s: scene %s, status %s, %d frame%s written%s\n", dir, info.scene_file,
+    printf("run %s: scene %s, status %s, %d frame%s written%s\n", dir, info.source_file,
            run_status, nframes, nframes == 1 ? "" : "s", have_records ? "" : " (no frames.jsonl)");
     printf("pairs: intersecting triangle pairs (src rec: frames.jsonl, verifier: counted on the "
            "frame file%s); kinetic: from the positions of consecutive frames (mean velocity "

@@ -334,6 +334,71 @@ int cs_outdir_start(cs_outdir *o, bool resuming, bool quiet, const cs_run_identi
     return status;
 }
 
+/* ------------------------------------------------------- the scene */
+
+char *cs_outdir_scene(const char *dir)
+{
+    char *path = cs_path_join(dir, "scene.yaml");
+    struct stat st;
+    if (path && (stat(path, &st) != 0 || !S_ISREG(st.st_mode))) {
+        free(path);
+        path = NULL;
+    }
+    return path;
+}
+
+/* source into dest, unless dest is there already (a name of its content)
+ * or is source itself. */
+static int copy_asset(const char *source, const char *dest, char *err, size_t errlen)
+{
+    struct stat a, b;
+    if (stat(dest, &b) == 0)
+        return 0;
+    if (stat(source, &a) != 0) {
+        snprintf(err, errlen, "cannot read %s: %s", source, strerror(errno));
+        return -1;
+    }
+    char *slash = strrchr(dest, '/');
+    if (slash) {
+        *slash = '\0';
+        int made = cs_make_dirs(dest);
+        *slash = '/';
+        if (made != 0) {
+            snprintf(err, errlen, "cannot create the folder of %s: %s", dest, strerror(errno));
+            return -1;
+        }
+    }
+    size_t len;
+    char *data = cs_file_read_all(source, &len);
+    if (!data) {
+        snprintf(err, errlen, "cannot read %s: %s", source, strerror(errno));
+        return -1;
+    }
+    int rc = cs_file_write_atomic(dest, data, len, err, errlen);
+    free(data);
+    return rc;
+}
+
+int cs_outdir_write_scene(cs_outdir *o, const cs_scene *scene, char *err, size_t errlen)
+{
+    for (int i = 0; i < scene->nassets; i++) {
+        char *dest = cs_path_join(o->dir, scene->assets[i].name);
+        int rc = dest ? copy_asset(scene->assets[i].source, dest, err, errlen) : -1;
+        if (!dest)
+            snprintf(err, errlen, "out of memory");
+        free(dest);
+        if (rc != 0)
+            return -1;
+    }
+    char *path = cs_path_join(o->dir, "scene.yaml");
+    int rc = path ? cs_file_write_atomic(path, scene->resolved, scene->resolved_len, err, errlen)
+                  : -1;
+    if (!path)
+        snprintf(err, errlen, "out of memory");
+    free(path);
+    return rc;
+}
+
 int cs_outdir_save_state(cs_outdir *o, const cs_run_identity *id, int frame,
                          const char *state_hash, cs_sim *sim, const cs_summary *s, char *err,
                          size_t errlen)

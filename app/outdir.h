@@ -6,6 +6,10 @@
  *   DIR/frames.jsonl            a record per simulated frame, one JSON a line
  *   DIR/summary.json            the run as a whole (summary.h)
  *   DIR/state.h5                what --resume continues from (checkpoint.h)
+ *   DIR/scene.yaml              the resolved scene (cs_scene.resolved): every
+ *                               key with its value, its files in DIR/assets/
+ *   DIR/assets/                 the mesh files and level sets the scene read,
+ *                               named by their content
  *   DIR/.lock                   held while a run writes (lock.h)
  * A new run takes the folder over: frames, records and state of an earlier
  * run there are removed. --resume continues the earlier run instead.
@@ -90,6 +94,15 @@ void cs_outdir_free(cs_outdir *o);
  * (unless quiet), on stderr. Returns an exit status. */
 int cs_outdir_start(cs_outdir *o, bool resume, bool quiet, const cs_run_identity *id,
                     cs_sim *sim, cs_summary *s, int frames, int *first_frame);
+
+/* Rank 0, once the folder is taken: DIR/scene.yaml (atomically) and the
+ * files it names copied into DIR/assets/ (a file already there under its
+ * content's name is kept), so that DIR alone runs, renders and resumes.
+ * Returns 0, or -1 with err naming the file. */
+int cs_outdir_write_scene(cs_outdir *o, const cs_scene *scene, char *err, size_t errlen);
+
+/* "DIR/scene.yaml" when dir holds one (malloc'd), else NULL. */
+char *cs_outdir_scene(const char *dir);
 
 /* Rank 0, after frame (after cs_sim_state_gather): DIR/state.h5 for it,
  * with the summary's totals. Returns 0, or -1 with err. */

@@ -2,8 +2,9 @@
  * is its output folder) or of a scene's initial state (TARGET is the scene
  * file), turntables, and animations of the frames (--animation).
  *
- * A run folder names its scene file and the --set overrides it ran with in
- * summary.json, so the scene is reloaded exactly: cloth colours, bodies
+ * A run folder holds its resolved scene, DIR/scene.yaml (an older one names
+ * its scene file and the --set overrides it ran with in summary.json), so
+ * the scene is reloaded exactly: cloth colours, bodies
  * and their motion, the camera. A frame keeps its cloths apart (outdir.h:
  * an object per cloth in OBJ and glTF, a file per cloth in PLY), so each is
  * read back by its name. A frame without them (written before frames kept

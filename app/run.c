@@ -48,6 +48,9 @@ typedef struct run_options {
     int noverrides;
     char **overrides;         /* "KEY=VALUE", --frames last */
     char *frames_override;    /* owned "time.frames=N" */
+    char *scene_in_dir;       /* owned DIR/scene.yaml when SCENE is a run folder */
+    char *format_override;    /* owned "output.format=FMT" for --format: loaded
+                                 last, so the resolved scene holds the format */
     bool plan_only;
     bool quiet;
     bool resume;              /* --resume: continue the run in DIR */
@@ -63,7 +66,10 @@ void cs_run_help(FILE *out)
         "\n"
         "Simulates the scene file SCENE (YAML) and writes one mesh file per frame,\n"
         "frame 0 being the initial state, with a progress display while it runs and\n"
-        "a table of time per stage at the end.\n"
+        "a table of time per stage at the end. DIR/scene.yaml is the scene resolved\n"
+        "(every setting written out, overrides applied) and DIR/assets/ the mesh\n"
+        "files and level sets it read: SCENE may be such a run folder, which then\n"
+        "stands for its scene.yaml and is the output folder (run DIR --resume).\n"
         "\n"
         "options:\n"
         "  -o, --output DIR     write into DIR (default: out/<scene name>): frames as\n"
@@ -230,6 +236,18 @@ static int parse_options(int argc, char **argv, run_options *o)
     o->scene_path = cs_cli_operand(&CLI, argc, argv, optind, "scene file", &status);
     if (!o->scene_path)
         return status;
+    /* a run folder stands for its resolved scene, and is the output */
+    struct stat st;
+    if (stat(o->scene_path, &st) == 0 && S_ISDIR(st.st_mode)) {
+        if (!(o->scene_in_dir = cs_outdir_scene(o->scene_path))) {
+            fprintf(stderr, "clothsim run: %s is a folder without scene.yaml: give a scene "
+                            "file, or a run folder written by 'clothsim run'\n", o->scene_path);
+            return CS_EXIT_INPUT;
+        }
+        if (!o->out_dir)
+            o->out_dir = o->scene_path;
+        o->scene_path = o->scene_in_dir;
+    }
     if ((o->render_size || o->render_samples) && !o->render)
         return cs_cli_error(&CLI, "%s", "--size and --samples go with --render ENGINE");
     if (frames) {
@@ -249,6 +267,8 @@ static void free_options(run_options *o)
 {
     free(o->overrides);
     free(o->frames_override);
+    free(o->scene_in_dir);
+    free(o->format_override);
 }
 
 /* ------------------------------------------------------------------ utils */
@@ -474,6 +494,11 @@ static int start_output(run_state *r, cs_progress *progress)
     if (r->first_frame == 0 && save_state(r, 0, r->summary.initial_hash, err, sizeof err) != 0)
         return output_failed(r, progress, err, "the state to resume from could not be written",
                              0);
+    /* before any frame is simulated: the folder runs, renders and resumes
+     * on its own (after --resume with the frames asked for now) */
+    if (cs_outdir_write_scene(&r->out, r->scene, err, sizeof err) != 0)
+        return output_failed(r, progress, err, "the resolved scene could not be written",
+                             r->first_frame);
     if (write_summary(r, err, sizeof err) != 0) {
         fprintf(stderr, "clothsim: %s\n", err);
         return -CS_EXIT_OUTPUT; /* stop without the report */
@@ -635,8 +660,20 @@ int cs_run_main(int argc, char **argv)
      * only rank 0 speaks */
     bool root = cs_parallel_rank() == 0;
     cs_parallel_set_threads(o.threads);
-    int rc = cs_scene_load(o.scene_path, o.noverrides, (const char *const *)o.overrides, &scene,
-                           err, sizeof err);
+    /* --format as an override loaded after the others (the resolved scene
+     * holds it); the run's identity and summary keep the overrides given */
+    if (o.format) {
+        size_t len = strlen("output.format=") + strlen(o.format) + 1;
+        if (!(o.format_override = malloc(len))) {
+            fprintf(stderr, "clothsim: out of memory\n");
+            status = CS_EXIT_OUTPUT;
+            goto done;
+        }
+        snprintf(o.format_override, len, "output.format=%s", o.format);
+        o.overrides[o.noverrides] = o.format_override;
+    }
+    int rc = cs_scene_load(o.scene_path, o.noverrides + (o.format ? 1 : 0),
+                           (const char *const *)o.overrides, &scene, err, sizeof err);
     if (rc != CS_IMPORT_OK) {
         if (root)
             fprintf(stderr, "clothsim: %s\n", err[0] ? err : "cannot load the scene");
@@ -706,6 +743,13 @@ int cs_run_main(int argc, char **argv)
         status = CS_EXIT_OUTPUT;
         goto done;
     }
+    /* the folder's own scene.yaml: rewritten as the run goes, so only its
+     * resolved scene can tell whether it is the run's */
+    char *own = cs_outdir_scene(r.out.dir);
+    struct stat a, b;
+    r.id.own_scene = own && stat(own, &a) == 0 && stat(scene->path, &b) == 0 &&
+                     a.st_dev == b.st_dev && a.st_ino == b.st_ino;
+    free(own);
     cs_state_hash(r.sim, r.summary.initial_hash); /* frame 0's, before any resume */
 
     cs_summary *s = &r.summary;

@@ -2,6 +2,8 @@
  * `clothsim run`. */
 #include "app/summary.h"
 
+#include "app/outdir.h"
+
 #include "app/run.h"
 #include "common/util.h"
 
@@ -466,6 +468,7 @@ void cs_summary_print_table(const cs_summary *s, FILE *out)
 void cs_run_info_free(cs_run_info *r)
 {
     free(r->scene_file);
+    free(r->source_file);
     for (int i = 0; i < r->noverrides; i++)
         free(r->overrides[i]);
     free(r->overrides);
@@ -536,8 +539,15 @@ int cs_run_info_read(const char *dir, cs_run_info *info, char *err, size_t errle
                                ? (int)written->valuedouble
                                : 0;
     info->fps = fps->valuedouble;
-    int status = read_overrides(over, path, info, err, errlen);
-    if (status == CS_EXIT_OK && !(info->scene_file = strdup(scene->valuestring))) {
+    /* a folder with its resolved scene needs neither the file the run
+     * came from nor its overrides, which that scene holds */
+    char *resolved = cs_outdir_scene(dir);
+    int status = resolved ? CS_EXIT_OK : read_overrides(over, path, info, err, errlen);
+    info->scene_file = resolved;
+    info->source_file = strdup(scene->valuestring);
+    if (status == CS_EXIT_OK && !resolved && info->source_file)
+        info->scene_file = strdup(info->source_file);
+    if (status == CS_EXIT_OK && (!info->source_file || !info->scene_file)) {
         snprintf(err, errlen, "out of memory");
         status = CS_EXIT_OUTPUT;
     }

@@ -131,7 +131,10 @@ void cs_summary_print_table(const cs_summary *s, FILE *out);
 
 /* What `clothsim render` reads back from a run's summary.json. */
 typedef struct cs_run_info {
-    char *scene_file;
+    char *scene_file;        /* DIR/scene.yaml when DIR has it (its overrides
+                                are in it: none below), else the scene file
+                                the run came from */
+    char *source_file;       /* the scene file the run came from */
     int noverrides;
     char **overrides;        /* the run's --set overrides, as given */
     cs_mesh_format format;

@@ -302,6 +302,15 @@ typedef struct cs_scene_mesh_body {
     double seconds;            /* converting or reading the grid */
 } cs_scene_mesh_body;
 
+/* A file a scene reads, to be copied into a run folder with its scene. */
+typedef struct cs_scene_asset {
+    char *source;              /* the file as read */
+    char *name;                /* where the resolved scene expects it, relative
+                                  to its folder: assets/<hash>/<file name> for
+                                  a mesh (the hash of its bytes), assets/<file
+                                  name> for a cached grid (named by its key) */
+} cs_scene_asset;
+
 typedef struct cs_scene {
     char *name;                /* from the file, else the file's stem */
     char *path;                /* the file it came from ("<string>" if none) */
@@ -319,6 +328,17 @@ typedef struct cs_scene {
     char **notes;
     bool allow_intersecting_start; /* check.allow_intersecting_start: `run`
                                       starts from intersecting cloth */
+    /* The resolved scene: YAML holding every key with its value (defaults
+     * written out, overrides applied, names and voxel sizes as chosen),
+     * mesh files and the level-set cache in assets/ beside it. Loaded from
+     * a folder holding it and its assets, it gives this scene again. */
+    char *resolved;
+    size_t resolved_len;
+    char *resolved_setup;      /* the same without time.frames: what a resumed
+                                  run must share with the run it continues */
+    size_t resolved_setup_len;
+    int nassets;
+    cs_scene_asset *assets;
 } cs_scene;
 
 /* Loads and validates a scene file, then applies command-line overrides,

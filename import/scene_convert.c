@@ -490,6 +490,13 @@ void cs_scene_destroy(cs_scene *s)
     }
     free(s->mesh_bodies);
     free(s->levelset_cache);
+    for (int i = 0; i < s->nassets; i++) {
+        free(s->assets[i].source);
+        free(s->assets[i].name);
+    }
+    free(s->assets);
+    free(s->resolved);
+    free(s->resolved_setup);
     for (int i = 0; i < s->nnotes; i++)
         free(s->notes[i]);
     free(s->notes);

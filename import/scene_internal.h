@@ -9,7 +9,8 @@
  *   3. --set overrides edit the document, which is emitted and loaded again;
  *   4. the raw structs become a cs_scene (scene_convert.c, scene_cloth.c,
  *      scene_mesh.c), each value checked once against its key's range;
- *   5. mesh bodies get their level sets (scene_mesh.c).
+ *   5. mesh bodies get their level sets (scene_mesh.c);
+ *   6. the resolved scene is written back as YAML (scene_emit.c).
  * The document stays alive to the end so that every message can be placed.
  */
 #ifndef CS_SCENE_INTERNAL_H
@@ -102,6 +103,10 @@ int cs_sl_convert_cloth(loader *L, const cs_raw_cloth *rc, int ci, cs_scene *s);
 
 /* ------------------------------------------------ scene_mesh.c */
 
+/* path relative to the scene file's folder, unless absolute (malloc'd). */
+char *cs_sl_scene_relative(const char *file, const char *path);
+/* mesh.scale at path: one number or three, from the document. */
+int cs_sl_read_scale(loader *L, const char *path, double out[3]);
 /* The mesh block at base.mesh: a file through assimp (*file: the path as
  * opened) or inline vertices. */
 int cs_sl_convert_mesh(loader *L, const cs_raw_mesh *m, const char *base, cs_trimesh **mesh,
@@ -115,5 +120,11 @@ int cs_sl_convert_mesh_body(loader *L, const cs_raw_body *rb, int bi, cs_scene *
 int cs_sl_finish_mesh_bodies(loader *L, cs_scene *s);
 /* The grids themselves, once the whole scene converted. */
 int cs_sl_build_levelsets(loader *L, cs_scene *s);
+
+/* ------------------------------------------------ scene_emit.c */
+
+/* The resolved scene of r (cs_scene.resolved, .resolved_setup) and the
+ * files to copy with it (cs_scene.assets), once s is complete. */
+int cs_sl_resolve(loader *L, const cs_raw_scene *r, cs_scene *s);
 
 #endif

@@ -120,7 +120,9 @@ static int load(const char *text, size_t len, const char *file, const char *defa
         if (rc == CS_IMPORT_BAD_INPUT)
             rc = cs_sl_report(L, false, err, errlen);
     }
-    if (rc == CS_IMPORT_OK && (rc = cs_sl_build_levelsets(L, *out)) != CS_IMPORT_OK) {
+    if (rc == CS_IMPORT_OK && ((rc = cs_sl_build_levelsets(L, *out)) != CS_IMPORT_OK ||
+                               (rc = cs_sl_resolve(L, merged ? merged : raw, *out)) !=
+                                   CS_IMPORT_OK)) {
         if (rc == CS_IMPORT_BAD_INPUT)
             cs_sl_report(L, L->noverrides > 0, err, errlen);
         cs_scene_destroy(*out);

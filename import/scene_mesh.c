@@ -13,8 +13,7 @@
 
 #include <yaml.h>
 
-/* path relative to the scene's folder, unless absolute */
-static char *scene_relative(const char *file, const char *path)
+char *cs_sl_scene_relative(const char *file, const char *path)
 {
     if (path[0] == '/')
         return cs_sl_strdup(path);
@@ -79,7 +78,7 @@ bool cs_mesh_body_grid(const cs_mesh_report *mesh, double *voxel, double cloth_e
 
 /* mesh.scale: one number (uniform) or three, each > 0. Read from the
  * document: the schema cannot say "a number or a list". */
-static int read_scale(loader *L, const char *path, double out[3])
+int cs_sl_read_scale(loader *L, const char *path, double out[3])
 {
     static const char *want = "expected a number > 0 or a list of 3 numbers > 0";
     const cs_key_range *range = &CS_SKEY(mesh, scale)->range;
@@ -134,7 +133,7 @@ static int convert_placement(loader *L, const cs_raw_mesh *m, const char *mp, cs
     int rc;
     *pl = cs_default_mesh_placement();
     snprintf(p, sizeof p, "%s.scale", mp);
-    if ((rc = read_scale(L, p, pl->scale)))
+    if ((rc = cs_sl_read_scale(L, p, pl->scale)))
         return rc;
     if ((rc = cs_sl_vec(L, CS_SKEY(mesh, rotation), m->rotation, mp, NULL, deg)))
         return rc;
@@ -163,7 +162,7 @@ static int convert_mesh_file(loader *L, const cs_raw_mesh *m, const char *mp, cs
     snprintf(p, sizeof p, "%s.file", mp);
     if (!*m->file)
         return cs_sl_fail(L, p, false, "must not be empty");
-    if (!(*file = scene_relative(L->file, m->file)))
+    if (!(*file = cs_sl_scene_relative(L->file, m->file)))
         return CS_IMPORT_NOMEM;
     rc = cs_mesh_import(*file, &pl, mesh, rep, why, sizeof why);
     if (rc == CS_IMPORT_BAD_INPUT) {

@@ -211,13 +211,27 @@ const cyaml_schema_value_t cs_scene_schema = {
 #define NAMES_VLIST(a) NULL, 0
 #define NAMES_ILIST(a) NULL, 0
 #define NAMES_IDXLIST(a) NULL, 0
+#define COUNT_LIST(sec, key) offsetof(cs_raw_##sec, key##_count)
+#define COUNT_VLIST COUNT_LIST
+#define COUNT_ILIST COUNT_LIST
+#define COUNT_IDXLIST COUNT_LIST
+#define COUNT_NUM(sec, key) 0
+#define COUNT_INT COUNT_NUM
+#define COUNT_BOOL COUNT_NUM
+#define COUNT_STR COUNT_NUM
+#define COUNT_DT COUNT_NUM
+#define COUNT_ENUM COUNT_NUM
+#define COUNT_VEC COUNT_NUM
+#define COUNT_IVEC COUNT_NUM
+#define COUNT_SCALE COUNT_NUM
+#define COUNT_MAP COUNT_NUM
 
 const cs_scene_key cs_scene_keys[CS_KEY_COUNT] = {
 #define CS_SECTION(sec, ttype, tname, heading)
 #define CS_KEY(sec, key, TYPE, ARG, REQ, DEF, DEFTEXT, RANGE, UNIT, HOW, FIELD, DOC)          \
     {CS_SEC_##sec, #key, CS_KT_##TYPE, N_##TYPE(ARG), CHILD_##TYPE(ARG), NAMES_##TYPE(ARG), \
      CS_IS_##REQ, RAW_##TYPE(sec, key), HASDEF_##DEF ? def_##sec##_##key : NULL, DEFTEXT,    \
-     RANGE_##RANGE, UNIT, TARGET_##HOW(sec, FIELD), DOC},
+     RANGE_##RANGE, UNIT, TARGET_##HOW(sec, FIELD), DOC, COUNT_##TYPE(sec, key)},
 #define CS_END(sec)
 #define CS_IS_OPT false
 #define CS_IS_REQ true
@@ -228,7 +242,8 @@ const cs_scene_key cs_scene_keys[CS_KEY_COUNT] = {
 };
 
 const cs_scene_section cs_scene_sections[CS_SEC_COUNT] = {
-#define CS_SECTION(sec, ttype, tname, heading) {#sec, tname, heading, sec##_fields},
+#define CS_SECTION(sec, ttype, tname, heading) \
+    {#sec, tname, heading, sec##_fields, sizeof(cs_raw_##sec)},
 #define CS_KEY(sec, key, TYPE, ARG, REQ, DEF, DEFTEXT, RANGE, UNIT, HOW, FIELD, DOC)
 #define CS_END(sec)
 #include "import/scene_keys.def"

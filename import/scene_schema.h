@@ -108,6 +108,7 @@ typedef struct cs_scene_key {
     const char *unit;
     long target;                 /* offset into the section's ttype; -1: by hand */
     const char *doc;
+    size_t count;                /* LIST, VLIST, ILIST, IDXLIST: offset of <key>_count */
 } cs_scene_key;
 
 typedef struct cs_scene_section {
@@ -115,6 +116,7 @@ typedef struct cs_scene_section {
     const char *tname;           /* "mapping", "selection", "motion" */
     const char *heading;         /* e.g. "self_collision" */
     const cyaml_schema_field_t *fields;
+    size_t size;                 /* of cs_raw_<section> */
 } cs_scene_section;
 
 extern const cs_scene_key cs_scene_keys[CS_KEY_COUNT];
