@@ -323,10 +323,13 @@ static int convert_time(loader *L, const cs_raw_time *t, cs_scene *s)
     char *end;
     double dt = 0;
     if (strcmp(t->dt, "auto") != 0) {
+        const cs_key_range *range = &CS_SKEY(time, dt)->range;
+        char text[64];
+        cs_key_range_text(range, text, sizeof text);
         dt = strtod(t->dt, &end);
         if (!*t->dt || isspace((unsigned char)*t->dt) || *end || !isfinite(dt) ||
-            !cs_key_in_range(&CS_SKEY(time, dt)->range, dt))
-            return cs_sl_fail(L, "time.dt", true, "expected a number >= 0 or auto");
+            !cs_key_in_range(range, dt))
+            return cs_sl_fail(L, "time.dt", true, "expected a number %s or auto", text);
     }
     s->def.dt = dt;
     return CS_IMPORT_OK;

@@ -2,10 +2,10 @@
  *
  * The scene text as a libyaml document (yaml_parser_load), used beside
  * libcyaml for what cyaml does not tell: the line of a key path, the text
- * of the value found there, and --set overrides, which are applied to the
- * document and emitted back to text for cyaml to load. Nodes added by an
- * override remember which one (owner), so that a later error in them names
- * the override instead of a file line.
+ * of the value found there, and --set overrides, whose values are parsed
+ * into the document (from where scene_set.c takes them into the raw
+ * structs). Nodes added by an override remember which one (owner), so that
+ * a later error in them names the override instead of a file line.
  */
 #ifndef CS_SCENE_DOC_H
 #define CS_SCENE_DOC_H
@@ -60,8 +60,5 @@ void cs_sdoc_describe(const cs_sdoc *d, int node, char *buf, size_t len);
  * keys on the way; new nodes get owner k. CS_SDOC_BAD with a reason in msg
  * for a bad path, an index past the end, or a value that is not YAML. */
 int cs_sdoc_set(cs_sdoc *d, const cs_spath *p, const char *value, int k, char *msg, size_t msglen);
-
-/* The document as YAML text (malloc'd, NUL-terminated). */
-int cs_sdoc_emit(const cs_sdoc *d, char **text, size_t *len, char *msg, size_t msglen);
 
 #endif

@@ -155,7 +155,7 @@ static bool starts(const char *s, const char *prefix)
 }
 
 /* Expected-versus-found for a value of the wrong kind at p. */
-static int fail_type(loader *L, const cs_spath *p)
+int cs_sl_fail_type(loader *L, const cs_spath *p)
 {
     char want[160], got[128];
     cs_sloc loc;
@@ -264,14 +264,14 @@ static int translate_cyaml(loader *L, cyaml_err_t e)
                                  (unsigned)v->sequence.max, have);
     }
     if (starts(what, "Invalid ") || starts(what, "Expecting "))
-        return fail_type(L, &p);
+        return cs_sl_fail_type(L, &p);
     return cs_sl_fail_at(L, &p, false, "%s", what);
 }
 
 /* Number and boolean text, stricter than cyaml: whole text, finite, and
  * booleans that cyaml reads the way they look. */
-static int check_scalar(loader *L, const yaml_node_t *n, const cyaml_schema_value_t *v,
-                        const cs_spath *p)
+int cs_sl_check_scalar(loader *L, const yaml_node_t *n, const cyaml_schema_value_t *v,
+                       const cs_spath *p)
 {
     const char *s = (const char *)n->data.scalar.value;
     char *end;
@@ -314,7 +314,7 @@ static int check_scalars(loader *L, int id, const cyaml_schema_value_t *v, cs_sp
     if (!n || !v)
         return CS_IMPORT_OK;
     if (n->type == YAML_SCALAR_NODE)
-        return check_scalar(L, n, v, p);
+        return cs_sl_check_scalar(L, n, v, p);
     if (n->type == YAML_MAPPING_NODE && v->type == CYAML_MAPPING) {
         long npairs = n->data.mapping.pairs.top - n->data.mapping.pairs.start;
         for (long i = 0; rc == CS_IMPORT_OK && i < npairs; i++) {
@@ -356,7 +356,7 @@ static const cyaml_config_t *cyaml_config_for(loader *L, cyaml_config_t *cfg)
     return cfg;
 }
 
-/* Stage 2 and 3 on text whose document is L->doc. */
+/* Stage 2 on text whose document is L->doc. */
 int cs_sl_load_raw(loader *L, const char *text, size_t len, cs_raw_scene **raw)
 {
     cyaml_config_t cfg;
@@ -370,7 +370,7 @@ int cs_sl_load_raw(loader *L, const char *text, size_t len, cs_raw_scene **raw)
     if (e != CYAML_OK)
         return translate_cyaml(L, e);
     if (!*raw)
-        return fail_type(L, &p);
+        return cs_sl_fail_type(L, &p);
     return check_scalars(L, cs_sdoc_root(&L->doc), &cs_scene_schema, &p);
 }
 
@@ -379,4 +379,10 @@ void cs_sl_free_raw(loader *L, cs_raw_scene *raw)
     cyaml_config_t cfg;
     if (raw)
         cyaml_free(cyaml_config_for(L, &cfg), &cs_scene_schema, raw, 0);
+}
+
+void cs_sl_free_value(loader *L, const cyaml_schema_value_t *v, void *data, unsigned count)
+{
+    cyaml_config_t cfg;
+    cyaml_free(cyaml_config_for(L, &cfg), v, data, count);
 }

@@ -6,7 +6,8 @@
  *      scene_keys.def); scene_errors.c turns its log into "KEY.PATH: what
  *      was expected (got X)" placed at the key's line, and checks number
  *      and boolean text strictly (cyaml 1.3 reads "3x" as 3);
- *   3. --set overrides edit the document, which is emitted and loaded again;
+ *   3. --set overrides: each value is parsed into the document, from where
+ *      it goes into the raw structs through its key's row (scene_set.c);
  *   4. the raw structs become a cs_scene (scene_convert.c, scene_cloth.c,
  *      scene_mesh.c), each value checked once against its key's range;
  *   5. mesh bodies get their level sets (scene_mesh.c);
@@ -61,6 +62,23 @@ int cs_sl_report(loader *L, bool blame, char *err, size_t errlen);
 /* Stages 2 on text whose document is L->doc. */
 int cs_sl_load_raw(loader *L, const char *text, size_t len, cs_raw_scene **raw);
 void cs_sl_free_raw(loader *L, cs_raw_scene *raw);
+/* A value of the wrong kind at p: "expected X (got Y)". */
+int cs_sl_fail_type(loader *L, const cs_spath *p);
+/* Number, integer and boolean text of node n, whose schema is v, as
+ * strictly as the file's own is checked. */
+int cs_sl_check_scalar(loader *L, const yaml_node_t *n, const cyaml_schema_value_t *v,
+                       const cs_spath *p);
+/* Frees a value libcyaml's way (v a pointer schema; count: of a sequence). */
+void cs_sl_free_value(loader *L, const cyaml_schema_value_t *v, void *data, unsigned count);
+
+/* ------------------------------------------------ scene_set.c */
+
+/* The override whose value cs_sdoc_set put at path p of the document,
+ * into raw: the member of the innermost section on p, replaced whole. */
+int cs_sl_apply_override(loader *L, cs_raw_scene *raw, const cs_spath *p);
+/* Every required key of the mappings under raw (of section sec) is there;
+ * p: raw's path, given back as it came. */
+int cs_sl_check_required(loader *L, int sec, const void *raw, cs_spath *p);
 
 /* ------------------------------------------------ scene_convert.c */
 

@@ -1,5 +1,5 @@
 /* scene_load.c: the load driver: a scene file (or text) through the stages
- * of scene_internal.h, with --set overrides applied to the document. */
+ * of scene_internal.h, with --set overrides applied to the parsed scene. */
 #include "import/scene_internal.h"
 
 #include <errno.h>
@@ -9,8 +9,9 @@
 
 /* --------------------------------------------------------------- loading */
 
-/* Applies the overrides to L->doc and loads the result into *raw. */
-static int apply_overrides(loader *L, cs_raw_scene **raw, char *err, size_t errlen)
+/* Applies the overrides to L->doc and, through the rows of their keys, to
+ * raw; nothing is parsed again. */
+static int apply_overrides(loader *L, cs_raw_scene *raw, char *err, size_t errlen)
 {
     char msg[MSG_LEN];
     for (int k = 0; k < L->noverrides; k++) {
@@ -36,28 +37,19 @@ static int apply_overrides(loader *L, cs_raw_scene **raw, char *err, size_t errl
             cs_sl_set_err(err, errlen, "--set %s: %s", ov, msg);
             return CS_IMPORT_BAD_INPUT;
         }
+        if ((rc = cs_sl_apply_override(L, raw, &p)) != CS_IMPORT_OK)
+            return rc == CS_IMPORT_BAD_INPUT ? cs_sl_report(L, true, err, errlen) : rc;
     }
-    char *text;
-    size_t len;
-    int rc = cs_sdoc_emit(&L->doc, &text, &len, msg, sizeof msg);
-    if (rc == CS_SDOC_NOMEM)
-        return CS_IMPORT_NOMEM;
-    if (rc != CS_SDOC_OK) {
-        cs_sl_set_err(err, errlen, "--set %s: %s", L->overrides[L->noverrides - 1], msg);
-        return CS_IMPORT_BAD_INPUT;
-    }
-    rc = cs_sl_load_raw(L, text, len, raw);
-    free(text);
-    if (rc == CS_IMPORT_BAD_INPUT)
-        return cs_sl_report(L, true, err, errlen);
-    return rc;
+    cs_spath top = {0};
+    int rc = cs_sl_check_required(L, CS_SEC_scene, raw, &top);
+    return rc == CS_IMPORT_BAD_INPUT ? cs_sl_report(L, true, err, errlen) : rc;
 }
 
 /* The merged scene failed to convert. Errors in nodes an override made are
  * that override's; others are checked against the file alone, which may be
  * where the error really is. */
-static int report_merged(loader *L, const cs_raw_scene *orig, const char *default_name, char *err,
-                         size_t errlen)
+static int report_merged(loader *L, const char *text, size_t len, const char *default_name,
+                         char *err, size_t errlen)
 {
     cs_sloc loc;
     cs_sdoc_locate(&L->doc, &L->err_path, false, &loc);
@@ -66,9 +58,14 @@ static int report_merged(loader *L, const cs_raw_scene *orig, const char *defaul
     cs_spath path = L->err_path;
     char msg[MSG_LEN];
     memcpy(msg, L->err_msg, sizeof msg);
+    /* the file alone, loaded again only to place this error */
+    cs_raw_scene *orig = NULL;
     cs_scene *alone = NULL;
-    int rc = cs_sl_convert_scene(L, orig, default_name, &alone);
+    int rc = cs_sl_load_raw(L, text, len, &orig);
+    if (rc == CS_IMPORT_OK)
+        rc = cs_sl_convert_scene(L, orig, default_name, &alone);
     cs_scene_destroy(alone);
+    cs_sl_free_raw(L, orig);
     if (rc == CS_IMPORT_NOMEM)
         return rc;
     if (rc == CS_IMPORT_BAD_INPUT) {
@@ -86,7 +83,7 @@ static int load(const char *text, size_t len, const char *file, const char *defa
                 size_t errlen)
 {
     loader *L = calloc(1, sizeof *L);
-    cs_raw_scene *raw = NULL, *merged = NULL;
+    cs_raw_scene *raw = NULL;
     char msg[MSG_LEN];
     int line = 1, rc;
 
@@ -109,11 +106,11 @@ static int load(const char *text, size_t len, const char *file, const char *defa
     } else if ((rc = cs_sl_load_raw(L, text, len, &raw)) == CS_IMPORT_BAD_INPUT) {
         rc = cs_sl_report(L, false, err, errlen);
     } else if (rc == CS_IMPORT_OK && L->noverrides > 0) {
-        rc = apply_overrides(L, &merged, err, errlen);
+        rc = apply_overrides(L, raw, err, errlen);
         if (rc == CS_IMPORT_OK) {
-            rc = cs_sl_convert_scene(L, merged, default_name, out);
+            rc = cs_sl_convert_scene(L, raw, default_name, out);
             if (rc == CS_IMPORT_BAD_INPUT)
-                rc = report_merged(L, raw, default_name, err, errlen);
+                rc = report_merged(L, text, len, default_name, err, errlen);
         }
     } else if (rc == CS_IMPORT_OK) {
         rc = cs_sl_convert_scene(L, raw, default_name, out);
@@ -121,7 +118,7 @@ static int load(const char *text, size_t len, const char *file, const char *defa
             rc = cs_sl_report(L, false, err, errlen);
     }
     if (rc == CS_IMPORT_OK && ((rc = cs_sl_build_levelsets(L, *out)) != CS_IMPORT_OK ||
-                               (rc = cs_sl_resolve(L, merged ? merged : raw, *out)) !=
+                               (rc = cs_sl_resolve(L, raw, *out)) !=
                                    CS_IMPORT_OK)) {
         if (rc == CS_IMPORT_BAD_INPUT)
             cs_sl_report(L, L->noverrides > 0, err, errlen);
@@ -131,7 +128,6 @@ static int load(const char *text, size_t len, const char *file, const char *defa
     if (rc == CS_IMPORT_NOMEM)
         cs_sl_set_err(err, errlen, "%s: out of memory", file);
     cs_sl_free_raw(L, raw);
-    cs_sl_free_raw(L, merged);
     cs_sdoc_free(&L->doc);
     free(L);
     return rc;

@@ -80,8 +80,11 @@ bool cs_mesh_body_grid(const cs_mesh_report *mesh, double *voxel, double cloth_e
  * document: the schema cannot say "a number or a list". */
 int cs_sl_read_scale(loader *L, const char *path, double out[3])
 {
-    static const char *want = "expected a number > 0 or a list of 3 numbers > 0";
     const cs_key_range *range = &CS_SKEY(mesh, scale)->range;
+    char bound[64], want[192], one[96];
+    cs_key_range_text(range, bound, sizeof bound);
+    snprintf(want, sizeof want, "expected a number %s or a list of 3 numbers %s", bound, bound);
+    snprintf(one, sizeof one, "expected a number %s", bound);
     cs_spath p;
     cs_sloc loc;
     out[0] = out[1] = out[2] = 1;
@@ -108,16 +111,14 @@ int cs_sl_read_scale(loader *L, const char *path, double out[3])
         char ep[PATH_LEN + 8];
         snprintf(ep, sizeof ep, item ? "%s[%d]" : "%s", path, k);
         if (!e || e->type != YAML_SCALAR_NODE)
-            return cs_sl_fail(L, ep, true, "%s", item ? "expected a number > 0" : want);
+            return cs_sl_fail(L, ep, true, "%s", item ? one : want);
         const char *text = (const char *)e->data.scalar.value;
         char *end;
         double v = strtod(text, &end);
         if (!*text || isspace((unsigned char)*text) || *end || !isfinite(v))
-            return cs_sl_fail(L, ep, true, "%s", item ? "expected a number > 0" : want);
+            return cs_sl_fail(L, ep, true, "%s", item ? one : want);
         if (!cs_key_in_range(range, v)) {
-            char text[64];
-            cs_key_range_text(range, text, sizeof text);
-            return cs_sl_fail(L, ep, true, "must be %s", text);
+            return cs_sl_fail(L, ep, true, "must be %s", bound);
         }
         for (int d = item ? k : 0; d < (item ? k + 1 : 3); d++)
             out[d] = v;

@@ -330,6 +330,46 @@ static void test_override_errors(void **state)
                           "sphere");
 }
 
+/* An override goes into the parsed scene through its key's row: an entry
+ * of a vector, a mapping given whole, and the same messages as the file's
+ * own keys get; the resolved scene holds it. */
+static void test_overrides_through_rows(void **state)
+{
+    (void)state;
+    const char *text = "name: rows\n"
+                       "gravity: [0, -9.8, 0]\n"
+                       "cloths:\n"
+                       "  - grid: {resolution: [2, 2]}\n"
+                       "bodies:\n"
+                       "  - shape: plane\n";
+    const char *ov[] = {"gravity.1=-3", "self_collision={stiffness: 12}",
+                        "bodies.0.friction_keys=[{time: 0, friction: 0.7}]"};
+    cs_scene *s = load_ok(text, 3, ov);
+    assert_vec(s->def.gravity, 0, -3, 0);
+    assert_true(s->def.self.stiffness == 12);
+    assert_int_equal(s->def.bodies[0].nfriction_keys, 1);
+    assert_true(s->def.bodies[0].friction_keys[0].friction == 0.7);
+    assert_non_null(strstr(s->resolved, "gravity: [0, -3, 0]"));
+    assert_non_null(strstr(s->resolved, "  stiffness: 12\n"));
+    assert_null(strstr(s->resolved_setup, "frames:"));
+    cs_scene_destroy(s);
+    expect_override_error("self_collision.scheme=sometimes",
+                          "--set self_collision.scheme=sometimes: self_collision.scheme: expected "
+                          "one of fixed, rewind (got sometimes)");
+    expect_override_error("effects.bodies=maybe",
+                          "--set effects.bodies=maybe: effects.bodies: expected true or false "
+                          "(got maybe)");
+    expect_override_error("camera={position: [0, 0, 1], target: [0, 0, 0], fvo: 3}",
+                          "--set camera={position: [0, 0, 1], target: [0, 0, 0], fvo: 3}: "
+                          "camera.fvo: unknown key; did you mean fov?");
+    expect_override_error("bodies.0.friction_keys=[{time: 0}]",
+                          "--set bodies.0.friction_keys=[{time: 0}]: "
+                          "bodies[0].friction_keys[0].friction: required key is missing");
+    expect_override_error("time.dt=fast",
+                          "--set time.dt=fast: time.dt: expected a number >= 0 or auto (got fast)");
+    expect_override_error("cloths=[]", "--set cloths=[]: cloths: expected at least 1 entry (got 0)");
+}
+
 /* Errors in the file itself keep their file line when overrides are given. */
 static void test_override_keeps_file_lines(void **state)
 {
@@ -413,6 +453,7 @@ int main(void)
         cmocka_unit_test(test_error_geometry_and_selection),
         cmocka_unit_test(test_overrides_applied),
         cmocka_unit_test(test_override_errors),
+        cmocka_unit_test(test_overrides_through_rows),
         cmocka_unit_test(test_override_keeps_file_lines),
         cmocka_unit_test(test_friction_keys_errors),
     };
