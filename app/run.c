@@ -358,20 +358,31 @@ static int steps_per_frame(double fps, double dt)
     return n > 0 ? (int)n : 1;
 }
 
+/* Every row of the stage table in the order they run: the plan's numbered,
+ * the others with what would bring them in. */
 static void print_plan(const cs_scene *scene, const cs_sim *sim, FILE *out)
 {
-    cs_plan plan = cs_plan_from_def(&scene->def);
+    const cs_plan *plan = cs_sim_plan(sim);
     int width = 0;
-    for (int i = 0; i < plan.nstages; i++) {
-        int n = (int)strlen(cs_stage_name(plan.stages[i]));
+    for (int i = 0; i < CS_STAGE_COUNT; i++) {
+        int n = (int)strlen(cs_stage_name(cs_stage_in_order(i)));
         if (n > width)
             width = n;
     }
-    fprintf(out, "plan of scene '%s' (%s): %d stage%s per time step\n", scene->name,
-            scene->path, plan.nstages, plan.nstages == 1 ? "" : "s");
-    for (int i = 0; i < plan.nstages; i++)
-        fprintf(out, "  %d. %-*s  %s\n", i + 1, width, cs_stage_name(plan.stages[i]),
-                cs_stage_description(plan.stages[i]));
+    fprintf(out, "plan of scene '%s' (%s): %d of %d stages\n", scene->name, scene->path,
+            plan->nstages, CS_STAGE_COUNT);
+    const char *when = NULL;
+    for (int i = 0, number = 0; i < CS_STAGE_COUNT; i++) {
+        cs_stage st = cs_stage_in_order(i);
+        if (!when || strcmp(when, cs_stage_when(st)) != 0)
+            fprintf(out, " %s:\n", when = cs_stage_when(st));
+        if (cs_plan_has(plan, st))
+            fprintf(out, "  %2d. %-*s  %s\n", ++number, width, cs_stage_name(st),
+                    cs_stage_description(st));
+        else
+            fprintf(out, "   -  %-*s  left out: needs %s\n", width, cs_stage_name(st),
+                    cs_stage_condition(st));
+    }
     double dt = cs_sim_dt(sim);
     fprintf(out, "step size %.6g s (stability limit %.6g s): %d steps per frame at %g fps\n",
             dt, cs_sim_stable_dt(sim), steps_per_frame(scene->def.fps, dt), scene->def.fps);

@@ -355,8 +355,11 @@ cs_sim_def cs_default_sim_def(void);
 
 /* ------------------------------------------------------- plan and timing */
 
-/* The stages a step can contain, in the order they run. A plan holds only
- * the ones the scene calls for; the others are neither run nor allocated. */
+/* The stages of a time step, of an outer collision step and of a frame.
+ * The values name them (and index timing arrays and stored totals); the
+ * order they run in is the stage table's (sim/stages.c), cs_stage_in_order.
+ * A plan holds only the ones the scene calls for; the others are neither
+ * run nor allocated. */
 typedef enum cs_stage {
     CS_STAGE_REPULSION_PAIRS = 0,   /* A: repulsion pairs and their history */
     CS_STAGE_SCRIPTED_VERTICES,     /* prescribed positions and velocities */
@@ -374,19 +377,28 @@ typedef enum cs_stage {
     CS_STAGE_COUNT
 } cs_stage;
 
+/* The i-th stage of the table, 0 <= i < CS_STAGE_COUNT, in the order the
+ * stages run (CS_STAGE_COUNT outside that range). */
+cs_stage cs_stage_in_order(int i);
 const char *cs_stage_name(cs_stage stage);
+const char *cs_stage_description(cs_stage stage);
+/* What a scene needs for the stage to be in its plan ("always",
+ * "effects.self_collision", ...). */
+const char *cs_stage_condition(cs_stage stage);
+/* When the stage runs ("each time step", ...). */
+const char *cs_stage_when(cs_stage stage);
 /* The memory a run of this many particles will need at its peak, bytes (an
  * estimate from measurements, with a margin), so that a scene too large
  * for the machine is refused before anything is allocated. */
 double cs_sim_estimate_bytes(double particles, bool self_collision);
-const char *cs_stage_description(cs_stage stage);
 
 typedef struct cs_plan {
     int nstages;
     cs_stage stages[CS_STAGE_COUNT];
 } cs_plan;
 
-/* What the scene definition calls for, without creating anything. */
+/* What the scene definition calls for, without creating anything: its
+ * stages in the order they run. */
 cs_plan cs_plan_from_def(const cs_sim_def *def);
 bool cs_plan_has(const cs_plan *plan, cs_stage stage);
 
