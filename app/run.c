@@ -307,11 +307,11 @@ static int write_frame(run_state *r, int frame, char *err, size_t errlen)
     }
     double t0 = cs_now();
     int rc = cs_frame_write(&r->out.layout, r->frames_dir, frame, r->views, err, errlen);
-    if (rc == CS_IMPORT_OK && r->render && cs_run_render_frame(r->render, r->sim, frame, err,
+    if (rc == CS_OK && r->render && cs_run_render_frame(r->render, r->sim, frame, err,
                                                                errlen) != 0)
-        rc = CS_IMPORT_BAD_INPUT;
+        rc = CS_ERR_BAD_INPUT;
     r->summary.output_seconds += cs_now() - t0;
-    if (rc == CS_IMPORT_OK)
+    if (rc == CS_OK)
         r->summary.frames_written = frame + 1;
     return rc;
 }
@@ -452,7 +452,7 @@ static int record_frame(run_state *r, int frame, const cs_frame_stats *stats, do
                                 : -1,
     };
     cs_state_hash(r->sim, rec.state_hash);
-    if (write_frame(r, frame, err, sizeof err) != CS_IMPORT_OK)
+    if (write_frame(r, frame, err, sizeof err) != CS_OK)
         return output_failed(r, progress, err, "a frame file could not be written", frame);
     if (cs_summary_add_frame(s, &rec, err, sizeof err) != 0)
         return output_failed(r, progress, err, "the frame's record could not be written", frame);
@@ -480,7 +480,7 @@ static int record_frame(run_state *r, int frame, const cs_frame_stats *stats, do
 static int start_output(run_state *r, cs_progress *progress)
 {
     char err[ERRLEN];
-    if (r->first_frame == 0 && write_frame(r, 0, err, sizeof err) != CS_IMPORT_OK)
+    if (r->first_frame == 0 && write_frame(r, 0, err, sizeof err) != CS_OK)
         return output_failed(r, progress, err, "a frame file could not be written", 0);
     if (r->first_frame == 0 && save_state(r, 0, r->summary.initial_hash, err, sizeof err) != 0)
         return output_failed(r, progress, err, "the state to resume from could not be written",
@@ -587,11 +587,11 @@ static int simulate(run_state *r, const run_options *o)
             cs_progress_finish(&progress);
             if (root)
                 fprintf(stderr, "clothsim: frame %d failed (%s)\n", frame,
-                        rc == CS_ERR_NOMEM ? "out of memory" : "simulation error");
+                        cs_status_message(rc));
             s->status = "failed";
-            s->error = rc == CS_ERR_NOMEM ? "out of memory" : "simulation error";
+            s->error = cs_status_message(rc);
             s->failed_frame = frame;
-            status = CS_EXIT_OUTPUT;
+            status = cs_exit_status(rc);
             break;
         }
         cs_sim_state_gather(r->sim); /* the state to resume from, on rank 0 */
@@ -648,10 +648,10 @@ int cs_run_main(int argc, char **argv)
     cs_parallel_set_threads(o.threads);
     int rc = cs_scene_load(o.scene_path, o.noverrides, (const char *const *)o.overrides, &scene,
                            err, sizeof err);
-    if (rc != CS_IMPORT_OK) {
+    if (rc != CS_OK) {
         if (root)
             fprintf(stderr, "clothsim: %s\n", err[0] ? err : "cannot load the scene");
-        status = rc == CS_IMPORT_BAD_INPUT ? CS_EXIT_INPUT : CS_EXIT_OUTPUT;
+        status = cs_exit_status(rc);
         goto done;
     }
     r.scene = scene;
@@ -674,7 +674,7 @@ int cs_run_main(int argc, char **argv)
     if (rc != CS_OK) {
         if (root)
             fprintf(stderr, "clothsim: %s: %s\n", scene->path, err[0] ? err : "invalid scene");
-        status = rc == CS_ERR_NOMEM ? CS_EXIT_OUTPUT : CS_EXIT_INPUT;
+        status = cs_exit_status(rc);
         goto done;
     }
     if (root && scene->def.dt > cs_sim_damped_dt(r.sim)) /* allowed: a sufficient bound */

@@ -13,6 +13,8 @@
 #include <stdbool.h>
 #include <stddef.h>
 
+#include "common/error.h"
+
 #ifdef __cplusplus
 extern "C" {
 #endif
@@ -29,16 +31,9 @@ typedef int cs_comm;
 
 /* ---------------------------------------------------------------- status */
 
-/* Every fallible call returns CS_OK or a negative code and, where a message
- * buffer is given, a sentence that says what was wrong. */
-enum {
-    CS_OK = 0,
-    CS_ERR_INVALID = -1,   /* a definition that makes no sense */
-    CS_ERR_NOMEM = -2,
-    CS_ERR_UNSTABLE = -3,  /* NaN or runaway velocity detected */
-    CS_ERR_SCRIPT = -4,    /* step C found no collision-free state that
-                              follows the scripts (cs_sim_script_conflict) */
-};
+/* Every fallible call returns CS_OK or a negative cs_status (CS_ERR_INVALID,
+ * CS_ERR_NOMEM, CS_ERR_UNSTABLE, CS_ERR_SCRIPT) and, where a message buffer
+ * is given, a sentence that says what was wrong. */
 
 /* -------------------------------------------------------------- geometry */
 
