@@ -61,7 +61,7 @@ cs_trimesh *cs_mesh_read(const char *path, char *err, size_t errlen);
 
 /* The same for the named meshes of a file (cs_mesh_write's views, one
  * child process for all): out[i] gets the nodes and meshes named names[i],
- * merged. Returns CS_OK, or a CS_IMPORT_* status with err (a name
+ * merged. Returns CS_OK, or a cs_status with err (a name
  * the file does not have is CS_ERR_BAD_INPUT) and every out[i] NULL. */
 int cs_mesh_read_named(const char *path, int n, const char *const *names, cs_trimesh **out,
                        char *err, size_t errlen);

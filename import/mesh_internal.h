@@ -52,7 +52,7 @@ const void *cs_bytes_take(cs_bytes_reader *r, size_t n);
 
 /* ------------------------------------------------------------- guard */
 
-/* Work to do in the child: fills out and returns a CS_IMPORT_* status with
+/* Work to do in the child: fills out and returns a cs_status with
  * a sentence in err on failure. */
 typedef int (*cs_guarded_fn)(void *ctx, cs_bytes *out, char *err, size_t errlen);
 
