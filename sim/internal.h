@@ -10,6 +10,19 @@
 #include "sim/springs.h"
 #include "sim/vec3.h"
 
+/* body.c: a body posed once for many queries */
+/* A body's frame at one time: for many queries at that time (a step asks
+ * each body about every point near it), computed once. */
+typedef struct cs_body_pose {
+    double R[9], c[3], velocity[3], omega[3];
+    bool unrotated; /* R is exactly the identity: queries skip the products */
+} cs_body_pose;
+void cs_body_def_pose(const cs_body_def *b, double t, cs_body_pose *pose);
+/* cs_body_def_phi and cs_body_def_velocity at a pose: the same numbers */
+double cs_body_posed_phi(const cs_body_def *b, const cs_body_pose *pose, const double x[3],
+                         double grad[3]);
+void cs_body_posed_velocity(const cs_body_pose *pose, const double x[3], double v[3]);
+
 /* What the solver may change about a particle's velocity. */
 enum { CS_FIXED = 0, CS_FREE = 1, CS_CONTACT = 2 };
 

@@ -165,18 +165,6 @@ cs_body_def cs_default_body_def(void);
 /* Signed distance and unit gradient of a body at world point x, time t. */
 double cs_body_def_phi(const cs_body_def *b, double t, const double x[3], double grad[3]);
 
-/* A body's frame at one time: for many queries at that time (a step asks
- * each body about every point near it), computed once. */
-typedef struct cs_body_pose {
-    double R[9], c[3], velocity[3], omega[3];
-    bool unrotated; /* R is exactly the identity: queries skip the products */
-} cs_body_pose;
-void cs_body_def_pose(const cs_body_def *b, double t, cs_body_pose *pose);
-/* cs_body_def_phi and cs_body_def_velocity at a pose: the same numbers */
-double cs_body_posed_phi(const cs_body_def *b, const cs_body_pose *pose, const double x[3],
-                         double grad[3]);
-void cs_body_posed_velocity(const cs_body_pose *pose, const double x[3], double v[3]);
-
 /* The body's Coulomb coefficient at time t: `friction`, or its schedule
  * evaluated at t (see cs_body_def.friction_keys). */
 double cs_body_def_friction(const cs_body_def *b, double t);
