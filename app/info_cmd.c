@@ -315,7 +315,7 @@ int cs_info_main(int argc, char **argv)
     cs_scene *scene = NULL;
     int rc = cs_scene_load(info.scene_file, info.noverrides, (const char *const *)info.overrides,
                            &scene, err, sizeof err);
-    if (rc != CS_IMPORT_OK) {
+    if (rc != CS_OK) {
         fprintf(stderr, "clothsim info: the run's scene %s does not load (%s): its cloths' "
                         "names and masses are needed to read the frames\n",
                 info.scene_file, err);

@@ -703,7 +703,7 @@ static int write_fixed(const cloth_set *s, const char *dir, char *err, size_t er
         const cs_trimesh *m = s->scene->def.cloths[c].mesh;
         cs_mesh_view view = {cloth_name(s, c), m->nv, s->x + 3 * (size_t)s->voff[c], m->nt,
                              m->tri};
-        if (cs_mesh_write(path, CS_MESH_PLY, 1, &view, err, errlen) != CS_IMPORT_OK)
+        if (cs_mesh_write(path, CS_MESH_PLY, 1, &view, err, errlen) != CS_OK)
             rc = -1;
         else if (n < cap)
             n += (size_t)snprintf(yaml + n, cap - n, "  - name: %s\n    mesh: {file: \"%s\"}\n",
@@ -883,9 +883,9 @@ int cs_check_main(int argc, char **argv)
     int rc = cs_scene_load(path, noverrides, (const char *const *)overrides, &scene, err,
                            sizeof err);
     free(overrides);
-    if (rc != CS_IMPORT_OK) {
+    if (rc != CS_OK) {
         fprintf(stderr, "clothsim check: %s\n", err[0] ? err : "cannot load the scene");
-        return rc == CS_IMPORT_BAD_INPUT ? CS_EXIT_INPUT : CS_EXIT_OUTPUT;
+        return cs_exit_status(rc);
     }
     for (int i = 0; i < scene->nnotes; i++)
         fprintf(stderr, "clothsim check: %s\n", scene->notes[i]);

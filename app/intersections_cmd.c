@@ -6,6 +6,7 @@
 #include "app/intersections_cmd.h"
 
 #include "app/cli.h"
+#include "app/exit.h"
 
 #include "import/import.h"
 #include "sim/sim.h"
@@ -18,7 +19,7 @@
 #define ERRLEN 1024
 #define LIST_MAX 20   /* pairs shown by --list */
 
-enum { EXIT_CLEAN = 0, EXIT_INTERSECTING = 1, EXIT_BAD_INPUT = 2, EXIT_NOMEM = 4 };
+enum { EXIT_INTERSECTING = 1 }; /* its own: 0 clean, 2 bad input, 4 no memory */
 
 void cs_intersections_help(FILE *out)
 {
@@ -43,7 +44,7 @@ void cs_intersections_help(FILE *out)
 }
 
 /* A bad command line is exit status 2 here, with the whole help. */
-static const cs_cli CLI = {"intersections", NULL, cs_intersections_help, EXIT_BAD_INPUT};
+static const cs_cli CLI = {"intersections", NULL, cs_intersections_help, CS_EXIT_INPUT};
 
 int cs_intersections_main(int argc, char **argv)
 {
@@ -63,7 +64,7 @@ int cs_intersections_main(int argc, char **argv)
             break;
         case 'h':
             cs_intersections_help(stdout);
-            return EXIT_CLEAN;
+            return CS_EXIT_OK;
         default:
             return cs_cli_option_error(&CLI, c, argv);
         }
@@ -77,7 +78,7 @@ int cs_intersections_main(int argc, char **argv)
     cs_trimesh *mesh = cs_mesh_read(path, err, sizeof err);
     if (!mesh) {
         fprintf(stderr, "clothsim intersections: %s\n", err);
-        return EXIT_BAD_INPUT;
+        return CS_EXIT_INPUT;
     }
     int pairs[2 * LIST_MAX];
     long n = cs_find_intersections(mesh->nv, mesh->x, mesh->nt, mesh->tri,
@@ -86,11 +87,11 @@ int cs_intersections_main(int argc, char **argv)
     cs_trimesh_destroy(mesh);
     if (n == CS_ERR_NOMEM) {
         fprintf(stderr, "clothsim intersections: out of memory for %d triangles\n", nt);
-        return EXIT_NOMEM;
+        return CS_EXIT_OUTPUT;
     }
     if (n < 0) {
         fprintf(stderr, "clothsim intersections: %s: invalid mesh\n", path);
-        return EXIT_BAD_INPUT;
+        return CS_EXIT_INPUT;
     }
     printf("%ld intersecting triangle pairs\n", n);
     if (list) {
@@ -99,5 +100,5 @@ int cs_intersections_main(int argc, char **argv)
         if (n > LIST_MAX)
             printf("(first %d of %ld shown)\n", LIST_MAX, n);
     }
-    return n == 0 ? EXIT_CLEAN : EXIT_INTERSECTING;
+    return n == 0 ? CS_EXIT_OK : EXIT_INTERSECTING;
 }

@@ -142,9 +142,9 @@ int cs_levelset_main(int argc, char **argv)
     cs_trimesh *mesh = NULL;
     cs_mesh_report rep;
     int rc = cs_mesh_import(path, &place, &mesh, &rep, err, sizeof err);
-    if (rc != CS_IMPORT_OK) {
+    if (rc != CS_OK) {
         fprintf(stderr, "clothsim levelset: %s\n", err);
-        return rc == CS_IMPORT_NOMEM ? CS_EXIT_OUTPUT : CS_EXIT_INPUT;
+        return cs_exit_status(rc);
     }
     if (rep.size_warning[0])
         fprintf(stderr, "clothsim levelset: warning: %s: %s\n", path, rep.size_warning);

@@ -155,9 +155,9 @@ int cs_mesh_info_main(int argc, char **argv)
     char err[1024];
     cs_mesh_catalog *cat = NULL;
     int rc = cs_mesh_catalog_read(path, &cat, err, sizeof err);
-    if (rc != CS_IMPORT_OK) {
+    if (rc != CS_OK) {
         fprintf(stderr, "clothsim mesh-info: %s\n", err);
-        return rc == CS_IMPORT_NOMEM ? CS_EXIT_OUTPUT : CS_EXIT_INPUT;
+        return cs_exit_status(rc);
     }
     printf("file:      %s\n", path);
     printf("format:    %s\n", cat->format);
@@ -167,10 +167,10 @@ int cs_mesh_info_main(int argc, char **argv)
     cs_trimesh *mesh = NULL;
     cs_mesh_report rep;
     rc = cs_mesh_import(path, &place, &mesh, &rep, err, sizeof err);
-    if (rc != CS_IMPORT_OK) {
+    if (rc != CS_OK) {
         fflush(stdout);
         fprintf(stderr, "clothsim mesh-info: %s\n", err);
-        return rc == CS_IMPORT_NOMEM ? CS_EXIT_OUTPUT : CS_EXIT_INPUT;
+        return cs_exit_status(rc);
     }
     print_report(&place, &rep);
     if (rep.size_warning[0]) {

@@ -117,8 +117,8 @@ int cs_frame_write(const cs_frame_layout *l, const char *frames_dir, int frame,
         cs_frame_file_path(l, frames_dir, frame, 0, path, sizeof path);
         return cs_mesh_write(path, l->format, l->ncloths, views, err, errlen);
     }
-    int rc = CS_IMPORT_OK;
-    for (int c = 0; c < l->ncloths && rc == CS_IMPORT_OK; c++) {
+    int rc = CS_OK;
+    for (int c = 0; c < l->ncloths && rc == CS_OK; c++) {
         cs_frame_file_path(l, frames_dir, frame, c, path, sizeof path);
         rc = cs_mesh_write(path, l->format, 1, &views[c], err, errlen);
     }
@@ -129,29 +129,28 @@ int cs_frame_read(const cs_frame_layout *l, const char *frames_dir, int frame, c
                   char *err, size_t errlen)
 {
     char path[4096];
-    int rc = CS_IMPORT_OK;
+    int rc = CS_OK;
     bool named = l->format != CS_MESH_PLY; /* else a file per cloth */
     for (int c = 0; c < l->ncloths; c++)
         out[c] = NULL;
-    for (int c = 0; c < (named ? 1 : l->ncloths) && rc == CS_IMPORT_OK; c++) {
+    for (int c = 0; c < (named ? 1 : l->ncloths) && rc == CS_OK; c++) {
         cs_frame_file_path(l, frames_dir, frame, c, path, sizeof path);
         if (access(path, F_OK) != 0) {
             snprintf(err, errlen, "%s: no such frame file (%s)", path, strerror(errno));
-            rc = CS_IMPORT_BAD_INPUT;
+            rc = CS_ERR_BAD_INPUT;
         } else if (!named) {
-            rc = (out[c] = cs_mesh_read(path, err, errlen)) ? CS_IMPORT_OK : CS_IMPORT_BAD_INPUT;
+            rc = (out[c] = cs_mesh_read(path, err, errlen)) ? CS_OK : CS_ERR_BAD_INPUT;
         } else {
             rc = cs_mesh_read_named(path, l->ncloths, (const char *const *)l->names, out, err,
                                     errlen);
         }
     }
-    if (rc != CS_IMPORT_OK)
+    if (rc != CS_OK)
         for (int c = 0; c < l->ncloths; c++) {
             cs_trimesh_destroy(out[c]);
             out[c] = NULL;
         }
-    return rc == CS_IMPORT_OK ? CS_EXIT_OK : rc == CS_IMPORT_NOMEM ? CS_EXIT_OUTPUT
-                                                                   : CS_EXIT_INPUT;
+    return cs_exit_status(rc);
 }
 
 /* ------------------------------------------------------------- the folder */

@@ -51,7 +51,7 @@ int cs_frame_layout_init(cs_frame_layout *l, cs_mesh_format format, int ncloths,
 void cs_frame_layout_free(cs_frame_layout *l);
 
 /* Writes frame's files into frames_dir: views[c] is cloth c (its name
- * from the layout). Returns a CS_IMPORT_* status with err. */
+ * from the layout). Returns a cs_status with err. */
 int cs_frame_write(const cs_frame_layout *l, const char *frames_dir, int frame,
                    cs_mesh_view *views, char *err, size_t errlen);
 

@@ -405,7 +405,7 @@ static int render_frames(job *j, const int *frames, int nframes)
         }
         char path[4200];
         cs_frame_path(path, sizeof path, j->out_dir, f, NULL, "png");
-        if (cs_image_write_png(j->image, path, err, sizeof err) != CS_RENDER_OK) {
+        if (cs_image_write_png(j->image, path, err, sizeof err) != CS_OK) {
             fprintf(stderr, "clothsim render: %s\n", err);
             return CS_EXIT_OUTPUT;
         }
@@ -605,7 +605,7 @@ static int render_turntable(job *j, int f)
         }
         char path[4200];
         snprintf(path, sizeof path, "%s/view_%03d.png", j->out_dir, k);
-        if (cs_image_write_png(j->image, path, err, sizeof err) != CS_RENDER_OK) {
+        if (cs_image_write_png(j->image, path, err, sizeof err) != CS_OK) {
             fprintf(stderr, "clothsim render: %s\n", err);
             status = CS_EXIT_OUTPUT;
             break;
@@ -625,7 +625,7 @@ static int render_turntable(job *j, int f)
         snprintf(path, sizeof path, "%s/contact_sheet.png", j->out_dir);
         int cols = n <= 4 ? n : n <= 8 ? 4 : (int)ceil(sqrt((double)n));
         if (cs_render_contact_sheet(path, n, (const cs_image *const *)thumbs, label_ptrs, cols,
-                                    thumb, err, sizeof err) != CS_RENDER_OK) {
+                                    thumb, err, sizeof err) != CS_OK) {
             fprintf(stderr, "clothsim render: %s\n", err);
             status = CS_EXIT_OUTPUT;
         } else if (!j->o->quiet) {
@@ -699,13 +699,13 @@ int cs_render_main(int argc, char **argv)
         all_overrides[j.info.noverrides + i] = o.overrides[i];
     int rc = cs_scene_load(scene_path, nover, (const char *const *)all_overrides, &scene, err,
                            sizeof err);
-    if (rc != CS_IMPORT_OK) {
+    if (rc != CS_OK) {
         fprintf(stderr, "clothsim render: %s\n", err[0] ? err : "cannot load the scene");
         if (j.run_mode && access(scene_path, R_OK) != 0)
             fprintf(stderr, "clothsim render: %s/summary.json names the scene file '%s'; run "
                             "from where the run was started, or give it with --scene FILE\n",
                     o.target, scene_path);
-        status = rc == CS_IMPORT_BAD_INPUT ? CS_EXIT_INPUT : CS_EXIT_OUTPUT;
+        status = cs_exit_status(rc);
         goto done;
     }
     j.scene = scene;

@@ -327,11 +327,11 @@ static int write_frame(run_state *r, int frame, char *err, size_t errlen)
     }
     double t0 = cs_now();
     int rc = cs_frame_write(&r->out.layout, r->frames_dir, frame, r->views, err, errlen);
-    if (rc == CS_IMPORT_OK && r->render && cs_run_render_frame(r->render, r->sim, frame, err,
+    if (rc == CS_OK && r->render && cs_run_render_frame(r->render, r->sim, frame, err,
                                                                errlen) != 0)
-        rc = CS_IMPORT_BAD_INPUT;
+        rc = CS_ERR_BAD_INPUT;
     r->summary.output_seconds += cs_now() - t0;
-    if (rc == CS_IMPORT_OK)
+    if (rc == CS_OK)
         r->summary.frames_written = frame + 1;
     return rc;
 }
@@ -378,20 +378,31 @@ static int steps_per_frame(double fps, double dt)
     return n > 0 ? (int)n : 1;
 }
 
+/* Every row of the stage table in the order they run: the plan's numbered,
+ * the others with what would bring them in. */
 static void print_plan(const cs_scene *scene, const cs_sim *sim, FILE *out)
 {
-    cs_plan plan = cs_plan_from_def(&scene->def);
+    const cs_plan *plan = cs_sim_plan(sim);
     int width = 0;
-    for (int i = 0; i < plan.nstages; i++) {
-        int n = (int)strlen(cs_stage_name(plan.stages[i]));
+    for (int i = 0; i < CS_STAGE_COUNT; i++) {
+        int n = (int)strlen(cs_stage_name(cs_stage_in_order(i)));
         if (n > width)
             width = n;
     }
-    fprintf(out, "plan of scene '%s' (%s): %d stage%s per time step\n", scene->name,
-            scene->path, plan.nstages, plan.nstages == 1 ? "" : "s");
-    for (int i = 0; i < plan.nstages; i++)
-        fprintf(out, "  %d. %-*s  %s\n", i + 1, width, cs_stage_name(plan.stages[i]),
-                cs_stage_description(plan.stages[i]));
+    fprintf(out, "plan of scene '%s' (%s): %d of %d stages\n", scene->name, scene->path,
+            plan->nstages, CS_STAGE_COUNT);
+    const char *when = NULL;
+    for (int i = 0, number = 0; i < CS_STAGE_COUNT; i++) {
+        cs_stage st = cs_stage_in_order(i);
+        if (!when || strcmp(when, cs_stage_when(st)) != 0)
+            fprintf(out, " %s:\n", when = cs_stage_when(st));
+        if (cs_plan_has(plan, st))
+            fprintf(out, "  %2d. %-*s  %s\n", ++number, width, cs_stage_name(st),
+                    cs_stage_description(st));
+        else
+            fprintf(out, "   -  %-*s  left out: needs %s\n", width, cs_stage_name(st),
+                    cs_stage_condition(st));
+    }
     double dt = cs_sim_dt(sim);
     fprintf(out, "step size %.6g s (stability limit %.6g s): %d steps per frame at %g fps\n",
             dt, cs_sim_stable_dt(sim), steps_per_frame(scene->def.fps, dt), scene->def.fps);
@@ -461,7 +472,7 @@ static int record_frame(run_state *r, int frame, const cs_frame_stats *stats, do
                                 : -1,
     };
     cs_state_hash(r->sim, rec.state_hash);
-    if (write_frame(r, frame, err, sizeof err) != CS_IMPORT_OK)
+    if (write_frame(r, frame, err, sizeof err) != CS_OK)
         return output_failed(r, progress, err, "a frame file could not be written", frame);
     if (cs_summary_add_frame(s, &rec, err, sizeof err) != 0)
         return output_failed(r, progress, err, "the frame's record could not be written", frame);
@@ -489,7 +500,7 @@ static int record_frame(run_state *r, int frame, const cs_frame_stats *stats, do
 static int start_output(run_state *r, cs_progress *progress)
 {
     char err[ERRLEN];
-    if (r->first_frame == 0 && write_frame(r, 0, err, sizeof err) != CS_IMPORT_OK)
+    if (r->first_frame == 0 && write_frame(r, 0, err, sizeof err) != CS_OK)
         return output_failed(r, progress, err, "a frame file could not be written", 0);
     if (r->first_frame == 0 && save_state(r, 0, r->summary.initial_hash, err, sizeof err) != 0)
         return output_failed(r, progress, err, "the state to resume from could not be written",
@@ -601,11 +612,11 @@ static int simulate(run_state *r, const run_options *o)
             cs_progress_finish(&progress);
             if (root)
                 fprintf(stderr, "clothsim: frame %d failed (%s)\n", frame,
-                        rc == CS_ERR_NOMEM ? "out of memory" : "simulation error");
+                        cs_status_message(rc));
             s->status = "failed";
-            s->error = rc == CS_ERR_NOMEM ? "out of memory" : "simulation error";
+            s->error = cs_status_message(rc);
             s->failed_frame = frame;
-            status = CS_EXIT_OUTPUT;
+            status = cs_exit_status(rc);
             break;
         }
         cs_sim_state_gather(r->sim); /* the state to resume from, on rank 0 */
@@ -674,10 +685,10 @@ int cs_run_main(int argc, char **argv)
     }
     int rc = cs_scene_load(o.scene_path, o.noverrides + (o.format ? 1 : 0),
                            (const char *const *)o.overrides, &scene, err, sizeof err);
-    if (rc != CS_IMPORT_OK) {
+    if (rc != CS_OK) {
         if (root)
             fprintf(stderr, "clothsim: %s\n", err[0] ? err : "cannot load the scene");
-        status = rc == CS_IMPORT_BAD_INPUT ? CS_EXIT_INPUT : CS_EXIT_OUTPUT;
+        status = cs_exit_status(rc);
         goto done;
     }
     r.scene = scene;
@@ -700,7 +711,7 @@ int cs_run_main(int argc, char **argv)
     if (rc != CS_OK) {
         if (root)
             fprintf(stderr, "clothsim: %s: %s\n", scene->path, err[0] ? err : "invalid scene");
-        status = rc == CS_ERR_NOMEM ? CS_EXIT_OUTPUT : CS_EXIT_INPUT;
+        status = cs_exit_status(rc);
         goto done;
     }
     if (root && scene->def.dt > cs_sim_damped_dt(r.sim)) /* allowed: a sufficient bound */

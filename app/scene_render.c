@@ -169,7 +169,7 @@ cs_scene_render *cs_scene_render_create(const cs_scene *scene,
             return NULL;
         }
     }
-    if (cs_render_settings_check(settings, err, errlen) != CS_RENDER_OK)
+    if (cs_render_settings_check(settings, err, errlen) != CS_OK)
         return NULL;
 
     cs_scene_render *sr = calloc(1, sizeof *sr);
@@ -250,7 +250,7 @@ cs_scene_render *cs_scene_render_create(const cs_scene *scene,
         }
         sr->camera = cs_render_camera_frame(lo, hi, (double)settings->width / settings->height);
     }
-    if (cs_render_camera_check(&sr->camera, err, errlen) != CS_RENDER_OK) {
+    if (cs_render_camera_check(&sr->camera, err, errlen) != CS_OK) {
         cs_scene_render_destroy(sr);
         return NULL;
     }
@@ -415,9 +415,9 @@ int cs_scene_render_draw(cs_scene_render *sr, double t, const cs_frame_cloths *c
 
     if (status == CS_EXIT_OK) {
         int rc = cs_renderer_draw(sr->renderer, n, meshes, camera, image, stats, err, errlen);
-        if (rc == CS_RENDER_BAD_INPUT)
+        if (rc == CS_ERR_BAD_INPUT)
             status = CS_EXIT_INPUT;
-        else if (rc != CS_RENDER_OK)
+        else if (rc != CS_OK)
             status = CS_EXIT_OUTPUT;
     }
     for (int b = 0; b < s->def.nbodies; b++)
@@ -648,7 +648,7 @@ int cs_run_render_frame(cs_run_render *rr, const cs_sim *sim, int frame, char *e
     }
     char path[4096];
     cs_frame_path(path, sizeof path, rr->images_dir, frame, NULL, "png");
-    if (cs_image_write_png(rr->image, path, msg, sizeof msg) != CS_RENDER_OK) {
+    if (cs_image_write_png(rr->image, path, msg, sizeof msg) != CS_OK) {
         snprintf(err, errlen, "%s", msg);
         return -1;
     }

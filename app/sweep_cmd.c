@@ -424,9 +424,9 @@ static int load(const char *path, int n, char **overrides, cs_scene **out)
     char err[ERRLEN] = "";
     cs_scene *scene = NULL;
     int rc = cs_scene_load(path, n, (const char *const *)overrides, &scene, err, sizeof err);
-    if (rc != CS_IMPORT_OK) {
+    if (rc != CS_OK) {
         fprintf(stderr, "clothsim: %s\n", err[0] ? err : "cannot load the scene");
-        return rc == CS_IMPORT_BAD_INPUT ? CS_EXIT_INPUT : CS_EXIT_OUTPUT;
+        return cs_exit_status(rc);
     }
     if (out)
         *out = scene;

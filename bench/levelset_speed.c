@@ -242,7 +242,7 @@ int main(int argc, char **argv)
     cs_mesh_placement pl = cs_default_mesh_placement();
     pl.scale[0] = pl.scale[1] = pl.scale[2] = 1.0 / 0.156; /* 1 m long */
     cs_trimesh *bunny = NULL;
-    if (cs_mesh_import(path, &pl, &bunny, NULL, err, sizeof err) == CS_IMPORT_OK &&
+    if (cs_mesh_import(path, &pl, &bunny, NULL, err, sizeof err) == CS_OK &&
         cs_mesh_close_holes(&bunny) >= 0) {
         for (int fill = 0; fill < 2; fill++) {
             convert("Stanford bunny, 1 m long", bunny, 0.01, fill);

@@ -122,7 +122,7 @@ int main(int argc, char **argv)
     for (int k = 0; k < RUNS; k++) {
         cs_render_stats st;
         double c0 = cpu_seconds();
-        if (cs_renderer_draw(r, 3, meshes, &cam, img, &st, err, sizeof err) != CS_RENDER_OK) {
+        if (cs_renderer_draw(r, 3, meshes, &cam, img, &st, err, sizeof err) != CS_OK) {
             fprintf(stderr, "bench_render_speed: %s\n", err);
             return 1;
         }
@@ -137,7 +137,7 @@ int main(int argc, char **argv)
     if (outdir) {
         char path[4096];
         snprintf(path, sizeof path, "%s/bench_embree.png", outdir);
-        if (cs_image_write_png(img, path, err, sizeof err) != CS_RENDER_OK)
+        if (cs_image_write_png(img, path, err, sizeof err) != CS_OK)
             fprintf(stderr, "bench_render_speed: %s\n", err);
     }
     double embree_s = median(secs, RUNS), embree_rays = median(rays, RUNS);
@@ -163,7 +163,7 @@ int main(int argc, char **argv)
             double c0 = cpu_seconds();
             for (int f = 0; f < frames; f++)
                 if (cs_renderer_draw(r, 3, meshes, &cam, img, NULL, err, sizeof err) !=
-                    CS_RENDER_OK) {
+                    CS_OK) {
                     fprintf(stderr, "bench_render_speed: %s\n", err);
                     return 1;
                 }
@@ -176,7 +176,7 @@ int main(int argc, char **argv)
         if (outdir && msaa) {
             char path[4096];
             snprintf(path, sizeof path, "%s/bench_preview.png", outdir);
-            if (cs_image_write_png(img, path, err, sizeof err) != CS_RENDER_OK)
+            if (cs_image_write_png(img, path, err, sizeof err) != CS_OK)
                 fprintf(stderr, "bench_render_speed: %s\n", err);
         }
     }

@@ -48,9 +48,9 @@ int LLVMFuzzerInitialize(int *argc, char ***argv)
 static void check(int rc, bool have, const char *err)
 {
     /* the contract of import.h: a result, or none with a message */
-    if (rc == CS_IMPORT_OK && !have)
+    if (rc == CS_OK && !have)
         abort();
-    if (rc != CS_IMPORT_OK && (have || (rc == CS_IMPORT_BAD_INPUT && !err[0])))
+    if (rc != CS_OK && (have || (rc == CS_ERR_BAD_INPUT && !err[0])))
         abort();
 }
 
@@ -88,7 +88,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
         cs_trimesh_destroy(mesh);
     } else if (reader == 1) {
         cs_trimesh *mesh = cs_mesh_read(path, err, sizeof err);
-        check(mesh ? CS_IMPORT_OK : CS_IMPORT_BAD_INPUT, mesh != NULL, err);
+        check(mesh ? CS_OK : CS_ERR_BAD_INPUT, mesh != NULL, err);
         for (int i = 0; mesh && i < 3 * mesh->nt; i++)
             if (mesh->tri[i] < 0 || mesh->tri[i] >= mesh->nv)
                 abort();

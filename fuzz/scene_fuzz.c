@@ -8,7 +8,7 @@
  * levelset.cache key writes there, never into the repository). Lines
  * "#set PATH=VALUE" (a YAML comment) are also passed as command-line
  * overrides, as `clothsim run --set` does, so the override code is fuzzed
- * too. A load must end in CS_IMPORT_OK or an error with a message; the
+ * too. A load must end in CS_OK or an error with a message; the
  * sanitizers and libFuzzer catch everything else. Mesh files go through
  * the normal path (cs_mesh_import in its guarded child process). */
 #include "import/import.h"
@@ -69,11 +69,11 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     int rc = cs_scene_load_string(text, CS_FUZZ_ROOT "/scenes/fuzz.yaml", nov, ov, &scene, err,
                                   sizeof err);
     /* the contract of import.h: a scene, or none with a message */
-    if (rc == CS_IMPORT_OK && !scene)
+    if (rc == CS_OK && !scene)
         abort();
-    if (rc != CS_IMPORT_OK && (scene || (rc == CS_IMPORT_BAD_INPUT && !err[0])))
+    if (rc != CS_OK && (scene || (rc == CS_ERR_BAD_INPUT && !err[0])))
         abort();
-    if (rc != CS_IMPORT_OK && rc != CS_IMPORT_BAD_INPUT && rc != CS_IMPORT_NOMEM)
+    if (rc != CS_OK && rc != CS_ERR_BAD_INPUT && rc != CS_ERR_NOMEM)
         abort();
     cs_scene_destroy(scene);
     for (int k = 0; k < nov; k++)

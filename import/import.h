@@ -11,6 +11,7 @@
 #include <stdbool.h>
 #include <stdio.h>
 
+#include "common/error.h"
 #include "import/levelset.h"
 #include "sim/sim.h"
 
@@ -18,13 +19,8 @@
 extern "C" {
 #endif
 
-/* Status codes of this module; a bad input file is CS_IMPORT_BAD_INPUT,
- * which the command turns into exit status 2. */
-enum {
-    CS_IMPORT_OK = 0,
-    CS_IMPORT_BAD_INPUT = -10,   /* unreadable, malformed or invalid input */
-    CS_IMPORT_NOMEM = -11,
-};
+/* Statuses (common/error.h): a bad input file is CS_ERR_BAD_INPUT, which
+ * the command turns into exit status 2; CS_ERR_NOMEM. */
 
 /* ------------------------------------------------------------- meshes */
 
@@ -51,7 +47,7 @@ typedef struct cs_mesh_view {
  * atomically (written beside it, then renamed), so a frame on disk is always
  * complete. A mesh with vertices and no triangles (nt 0) is written as
  * points: PLY vertices only, OBJ "p" lines, glTF POINTS. Returns
- * CS_IMPORT_OK or CS_IMPORT_BAD_INPUT with err filled. */
+ * CS_OK or CS_ERR_BAD_INPUT with err filled. */
 int cs_mesh_write(const char *path, cs_mesh_format format, int nmeshes,
                   const cs_mesh_view *meshes, char *err, size_t errlen);
 
@@ -65,8 +61,8 @@ cs_trimesh *cs_mesh_read(const char *path, char *err, size_t errlen);
 
 /* The same for the named meshes of a file (cs_mesh_write's views, one
  * child process for all): out[i] gets the nodes and meshes named names[i],
- * merged. Returns CS_IMPORT_OK, or a CS_IMPORT_* status with err (a name
- * the file does not have is CS_IMPORT_BAD_INPUT) and every out[i] NULL. */
+ * merged. Returns CS_OK, or a cs_status with err (a name
+ * the file does not have is CS_ERR_BAD_INPUT) and every out[i] NULL. */
 int cs_mesh_read_named(const char *path, int n, const char *const *names, cs_trimesh **out,
                        char *err, size_t errlen);
 
@@ -127,7 +123,7 @@ typedef struct cs_mesh_report {
  * unreadable or corrupt file, a node that is not there, a non-finite
  * coordinate, a result without triangles or one whose triangles use less
  * than half of the vertices (most of the file not understood) is
- * CS_IMPORT_BAD_INPUT with a sentence in err. The file is read in a child
+ * CS_ERR_BAD_INPUT with a sentence in err. The file is read in a child
  * process with limits on time and memory, so that no file can crash or
  * hang the caller (limits: CLOTHSIM_IMPORT_SECONDS of CPU, default 30 + 1
  * per MB of file; CLOTHSIM_IMPORT_MEMORY MB, default 1024 + 64 per MB). */
@@ -344,7 +340,7 @@ typedef struct cs_scene {
 /* Loads and validates a scene file, then applies command-line overrides,
  * each "dotted.path=value" with value written in YAML (e.g.
  * "time.frames=10", "gravity=[0,-9.8,0]", "cloths.0.material.node_mass=2e-6").
- * On failure returns CS_IMPORT_BAD_INPUT and writes one line into err of the
+ * On failure returns CS_ERR_BAD_INPUT and writes one line into err of the
  * form "FILE:LINE: KEY: what was expected" (or "--set KEY=VALUE: ..." when
  * an override is at fault). */
 int cs_scene_load(const char *path, int noverrides, const char *const *overrides,

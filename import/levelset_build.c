@@ -230,7 +230,7 @@ int cs_levelset_build(const cs_trimesh *mesh, const cs_levelset_request *req,
             if (res->grid) {
                 res->from_cache = true;
                 res->seconds = cs_now() - t0;
-                return CS_IMPORT_OK;
+                return CS_OK;
             }
             snprintf(res->cache_note, sizeof res->cache_note, "%s; converted again", why);
         }
@@ -238,7 +238,7 @@ int cs_levelset_build(const cs_trimesh *mesh, const cs_levelset_request *req,
     res->grid = cs_levelset_create(mesh, req->voxel_size, req->band, req->fill_interior, err,
                                    errlen);
     if (!res->grid)
-        return strstr(err ? err : "", "out of memory") ? CS_IMPORT_NOMEM : CS_IMPORT_BAD_INPUT;
+        return strstr(err ? err : "", "out of memory") ? CS_ERR_NOMEM : CS_ERR_BAD_INPUT;
     res->seconds = cs_now() - t0;
     if (req->cache_dir && res->key[0]) {
         char why[400], voxel[32];
@@ -256,5 +256,5 @@ int cs_levelset_build(const cs_trimesh *mesh, const cs_levelset_request *req,
             res->cache_path[0] = '\0';
         }
     }
-    return CS_IMPORT_OK;
+    return CS_OK;
 }

@@ -95,7 +95,7 @@ typedef struct checker {
         char why_[512];                                                  \
         snprintf(why_, sizeof why_, __VA_ARGS__);                        \
         cs_mesh_set_err((c)->err, (c)->errlen, "%s: %s", (c)->path, why_); \
-        return CS_IMPORT_BAD_INPUT;                                      \
+        return CS_ERR_BAD_INPUT;                                      \
     } while (0)
 
 /* The next whitespace-separated word of *s, NUL-terminated in place. */
@@ -118,7 +118,7 @@ static char *word(char **s)
 static int parse_property(checker *c, ply_header *h, char *rest, int line)
 {
     if (h->nelems == 0)
-        return CS_IMPORT_OK;   /* assimp ignores it too */
+        return CS_OK;   /* assimp ignores it too */
     ply_elem *e = &h->elems[h->nelems - 1];
     if (e->nprops == MAX_PROPS)
         FAIL(c, "PLY header line %d: element '%s' has more than %d properties", line, e->name,
@@ -143,7 +143,7 @@ static int parse_property(checker *c, ply_header *h, char *rest, int line)
     p->indices = p->count_type != T_BAD && !strcmp(e->name, "face") &&
                  (!strcmp(name, "vertex_indices") || !strcmp(name, "vertex_index"));
     e->nprops++;
-    return CS_IMPORT_OK;
+    return CS_OK;
 }
 
 /* Parses the header in buf (n bytes, the start of the file). */
@@ -203,7 +203,7 @@ static int parse_header(checker *c, char *buf, size_t n, ply_header *h)
             h->length = pos;
             h->crlf = cr;
             h->lines = line;
-            return CS_IMPORT_OK;
+            return CS_OK;
         }
     }
     if (n >= HEADER_MAX)
@@ -239,7 +239,7 @@ static int check_counts(checker *c, const ply_header *h, unsigned long long data
                  "which would keep one triangle of them; convert them to faces (e.g. in MeshLab "
                  "or Blender)");
     }
-    return CS_IMPORT_OK;
+    return CS_OK;
 }
 
 /* ------------------------------------------------------------ PLY data */
@@ -297,7 +297,7 @@ static int check_face_index(checker *c, const ply_header *h, unsigned long long 
     if (index < 0 || (unsigned long long)index >= h->vertices)
         FAIL(c, "PLY face %llu refers to vertex %lld, but the file has %llu vertices", face,
              index, h->vertices);
-    return CS_IMPORT_OK;
+    return CS_OK;
 }
 
 static int check_corners(checker *c, unsigned long long face, long long n)
@@ -305,7 +305,7 @@ static int check_corners(checker *c, unsigned long long face, long long n)
     if (n > CS_MESH_MAX_CORNERS)
         FAIL(c, "PLY face %llu has %lld corners; at most %d are read (triangulating a polygon "
              "takes time growing with the square of its corners)", face, n, CS_MESH_MAX_CORNERS);
-    return CS_IMPORT_OK;
+    return CS_OK;
 }
 
 #define TRUNCATED(w, e, i)                                                                  \
@@ -349,16 +349,16 @@ static int walk_binary(data_walk *w)
                     FAIL(w->c, "PLY %s %llu has a list of %lld entries, more than the %llu "
                          "bytes left in the file", e->name, i, n, w->left);
                 if (p->indices && check_corners(w->c, i, n))
-                    return CS_IMPORT_BAD_INPUT;
+                    return CS_ERR_BAD_INPUT;
                 for (long long j = 0; j < n; j++) {
                     if (!read_int(w, p->type, &v))
                         TRUNCATED(w, e, i);
                     if (p->indices && check_face_index(w->c, w->h, i, v))
-                        return CS_IMPORT_BAD_INPUT;
+                        return CS_ERR_BAD_INPUT;
                 }
             }
     }
-    return CS_IMPORT_OK;
+    return CS_OK;
 }
 
 static int check_number(checker *c, const char *tok, long line)
@@ -369,7 +369,7 @@ static int check_number(checker *c, const char *tok, long line)
     if (digits > CS_MESH_MAX_NUMBER_DIGITS)
         FAIL(c, "line %ld: a number of %zu digits (at most %d are read)", line, digits,
              CS_MESH_MAX_NUMBER_DIGITS);
-    return CS_IMPORT_OK;
+    return CS_OK;
 }
 
 /* The next line that holds something, its line end removed; NULL at the
@@ -416,11 +416,11 @@ static int ascii_list(data_walk *w, const ply_elem *e, const ply_prop *p, unsign
         FAIL(w->c, "line %ld: PLY %s %llu has a list of '%.40s' entries but %lld values follow "
              "on its line", lineno, e->name, i, count, avail);
     if (p->indices && check_corners(w->c, i, n))
-        return CS_IMPORT_BAD_INPUT;
+        return CS_ERR_BAD_INPUT;
     for (long long j = 0; j < n; j++) {
         char *tok = word(s);
         if (check_number(w->c, tok, lineno))
-            return CS_IMPORT_BAD_INPUT;
+            return CS_ERR_BAD_INPUT;
         if (!p->indices)
             continue;
         errno = 0;
@@ -429,9 +429,9 @@ static int ascii_list(data_walk *w, const ply_elem *e, const ply_prop *p, unsign
             FAIL(w->c, "line %ld: PLY face %llu has a vertex index '%.40s' that is not a whole "
                  "number", lineno, i, tok);
         if (check_face_index(w->c, w->h, i, v))
-            return CS_IMPORT_BAD_INPUT;
+            return CS_ERR_BAD_INPUT;
     }
-    return CS_IMPORT_OK;
+    return CS_OK;
 }
 
 /* ASCII PLY as assimp reads it: an instance per line. Values missing at a
@@ -440,7 +440,7 @@ static int walk_ascii(data_walk *w, long lineno)
 {
     char *line = NULL;
     size_t cap = 0;
-    int rc = CS_IMPORT_OK;
+    int rc = CS_OK;
     for (int ei = 0; ei < w->h->nelems && !rc; ei++) {
         const ply_elem *e = &w->h->elems[ei];
         for (unsigned long long i = 0; i < e->count && !rc; i++) {
@@ -449,7 +449,7 @@ static int walk_ascii(data_walk *w, long lineno)
                 cs_mesh_set_err(w->c->err, w->c->errlen, "%s: the file ends in %s %llu of the "
                                 "%llu its PLY header promises (truncated?)",
                                 w->c->path, e->name, i, e->count);
-                rc = CS_IMPORT_BAD_INPUT;
+                rc = CS_ERR_BAD_INPUT;
                 break;
             }
             for (int k = 0; k < e->nprops && !rc && (tok = word(&s)); k++) {
@@ -479,7 +479,7 @@ static int crlf_copy(checker *c, FILE *f, size_t size, const ply_header *h,
     unsigned char *out = malloc(size + 1);
     if (!out) {
         cs_mesh_set_err(c->err, c->errlen, "%s: out of memory", c->path);
-        return CS_IMPORT_NOMEM;
+        return CS_ERR_NOMEM;
     }
     size_t head = h->length - 1;   /* up to end_header's "\n" */
     rewind(f);
@@ -493,7 +493,7 @@ static int crlf_copy(checker *c, FILE *f, size_t size, const ply_header *h,
     res->data = out;
     res->len = size + 1;
     res->hint = "ply";
-    return CS_IMPORT_OK;
+    return CS_OK;
 }
 
 static int check_ply(checker *c, FILE *f, size_t size, cs_mesh_precheck_result *res)
@@ -501,7 +501,7 @@ static int check_ply(checker *c, FILE *f, size_t size, cs_mesh_precheck_result *
     size_t want = size < HEADER_MAX ? size : HEADER_MAX;
     char *buf = malloc(want + 1);
     ply_header *h = malloc(sizeof *h);
-    int rc = CS_IMPORT_NOMEM;
+    int rc = CS_ERR_NOMEM;
     if (!buf || !h) {
         cs_mesh_set_err(c->err, c->errlen, "%s: out of memory", c->path);
         goto done;
@@ -513,7 +513,7 @@ static int check_ply(checker *c, FILE *f, size_t size, cs_mesh_precheck_result *
         goto done;
     if (fseeko(f, (off_t)h->length, SEEK_SET) != 0) {
         cs_mesh_set_err(c->err, c->errlen, "cannot read %s: %s", c->path, strerror(errno));
-        rc = CS_IMPORT_BAD_INPUT;
+        rc = CS_ERR_BAD_INPUT;
         goto done;
     }
     data_walk w = {c, h, f, size - h->length};
@@ -553,7 +553,7 @@ static int scan_numbers(checker *c, FILE *f)
                 line += ch == '\n';
             }
         }
-    return CS_IMPORT_OK;
+    return CS_OK;
 }
 
 static bool has_extension(const char *path, const char *ext)
@@ -572,7 +572,7 @@ int cs_mesh_precheck(const char *path, cs_mesh_precheck_result *res, char *err, 
         cs_mesh_set_err(err, errlen, "cannot read %s: %s", path, strerror(errno));
         if (f)
             fclose(f);
-        return CS_IMPORT_BAD_INPUT;
+        return CS_ERR_BAD_INPUT;
     }
     unsigned char head[4096];
     size_t n = fread(head, 1, sizeof head, f);
@@ -585,7 +585,7 @@ int cs_mesh_precheck(const char *path, cs_mesh_precheck_result *res, char *err, 
         cs_mesh_set_err(err, errlen,
                         "cannot read %s: it starts like a PLY file but its first line is not "
                         "'ply'", path);
-        return CS_IMPORT_BAD_INPUT;
+        return CS_ERR_BAD_INPUT;
     }
     if (n >= 4 && !strncasecmp((const char *)head, "ply", 3))
         res->kind = CS_KIND_PLY;
@@ -593,7 +593,7 @@ int cs_mesh_precheck(const char *path, cs_mesh_precheck_result *res, char *err, 
         res->kind = CS_KIND_GLTF;
     else if (has_extension(path, "obj"))
         res->kind = CS_KIND_OBJ;
-    int rc = CS_IMPORT_OK;
+    int rc = CS_OK;
     if (res->kind == CS_KIND_PLY)
         rc = check_ply(&c, f, (size_t)st.st_size, res);
     else if (!memchr(head, 0, n))   /* text */
@@ -620,7 +620,7 @@ static int check_nodes(checker *c, const struct aiScene *scene, const struct aiN
         if (rc)
             return rc;
     }
-    return CS_IMPORT_OK;
+    return CS_OK;
 }
 
 /* Our own check rather than assimp's aiProcess_ValidateDataStructure,
@@ -653,5 +653,5 @@ int cs_mesh_check_scene(const struct aiScene *scene, const char *path, char *err
                          mesh->mNumVertices);
         }
     }
-    return scene->mRootNode ? check_nodes(&c, scene, scene->mRootNode, 0) : CS_IMPORT_OK;
+    return scene->mRootNode ? check_nodes(&c, scene, scene->mRootNode, 0) : CS_OK;
 }

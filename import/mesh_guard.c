@@ -212,8 +212,8 @@ static _Noreturn void child_main(int fd, const limits *l, cs_guarded_fn fn, void
     cs_bytes payload = {0}, msg = {0};
     char err[1024] = "";
     int32_t rc = fn(ctx, &payload, err, sizeof err);
-    if (payload.nomem && rc == CS_IMPORT_OK) {
-        rc = CS_IMPORT_NOMEM;
+    if (payload.nomem && rc == CS_OK) {
+        rc = CS_ERR_NOMEM;
         snprintf(err, sizeof err, "out of memory");
     }
     uint32_t magic = GUARD_MAGIC;
@@ -329,10 +329,10 @@ static void describe_death(int status, answer got, double cpu, const limits *l, 
 static int run_here(cs_guarded_fn fn, void *ctx, cs_bytes *result, char *err, size_t errlen)
 {
     int rc = fn(ctx, result, err, errlen);
-    if (result->nomem || rc == CS_IMPORT_NOMEM) {
+    if (result->nomem || rc == CS_ERR_NOMEM) {
         cs_bytes_free(result);
         cs_mesh_set_err(err, errlen, "out of memory");
-        return CS_IMPORT_NOMEM;
+        return CS_ERR_NOMEM;
     }
     return rc;
 }
@@ -349,7 +349,7 @@ int cs_guard_run(const char *path, cs_guarded_fn fn, void *ctx, cs_bytes *result
     if (pipe(fds) != 0) {
         cs_mesh_set_err(err, errlen, "cannot read %s: no pipe to a reading process: %s", path,
                         strerror(errno));
-        return CS_IMPORT_NOMEM;
+        return CS_ERR_NOMEM;
     }
     fflush(NULL);   /* nothing buffered is written twice */
     cs_bytes buf = {0};
@@ -360,7 +360,7 @@ int cs_guard_run(const char *path, cs_guarded_fn fn, void *ctx, cs_bytes *result
         if (start > 0 && pipe(fds) != 0) {
             cs_mesh_set_err(err, errlen, "cannot read %s: no pipe to a reading process: %s",
                             path, strerror(errno));
-            return CS_IMPORT_NOMEM;
+            return CS_ERR_NOMEM;
         }
         double cpu_before = children_cpu();
         pid_t pid = fork();
@@ -370,7 +370,7 @@ int cs_guard_run(const char *path, cs_guarded_fn fn, void *ctx, cs_bytes *result
             close(fds[1]);
             cs_mesh_set_err(err, errlen, "cannot read %s: cannot start a reading process: %s",
                             path, strerror(e));
-            return CS_IMPORT_NOMEM;
+            return CS_ERR_NOMEM;
         }
         if (pid == 0) {
             close(fds[0]);
@@ -388,7 +388,7 @@ int cs_guard_run(const char *path, cs_guarded_fn fn, void *ctx, cs_bytes *result
     }
     bool answered = got == ANSWERED;
 
-    int rc = CS_IMPORT_BAD_INPUT;
+    int rc = CS_ERR_BAD_INPUT;
     cs_bytes_reader r = {buf.data, buf.len, buf.nomem};
     uint32_t magic = 0;
     int32_t crc = 0;
@@ -400,13 +400,13 @@ int cs_guard_run(const char *path, cs_guarded_fn fn, void *ctx, cs_bytes *result
     cs_bytes_get(&r, &n, sizeof n);
     if (buf.nomem) {
         cs_mesh_set_err(err, errlen, "cannot read %s: out of memory", path);
-        rc = CS_IMPORT_NOMEM;
+        rc = CS_ERR_NOMEM;
     } else if (!answered || !WIFEXITED(status) || WEXITSTATUS(status) != 0 || r.bad ||
                magic != GUARD_MAGIC || n != r.left) {
         char why[512];
         describe_death(status, got, cpu, &l, why, sizeof why);
         cs_mesh_set_err(err, errlen, "cannot read %s: %s", path, why);
-    } else if (crc == CS_IMPORT_NOMEM) {
+    } else if (crc == CS_ERR_NOMEM) {
         /* in the child, most likely the limit: the file asked for more */
         cs_mesh_set_err(err, errlen, "cannot read %s: reading it needs more than %g MB of memory "
                         "(CLOTHSIM_IMPORT_MEMORY sets the limit); the file may claim more than it "
@@ -414,12 +414,12 @@ int cs_guard_run(const char *path, cs_guarded_fn fn, void *ctx, cs_bytes *result
     } else {
         /* the payload is what follows the header; it comes with a failure
          * too (the import's report) */
-        if (crc != CS_IMPORT_OK)
+        if (crc != CS_OK)
             cs_mesh_set_err(err, errlen, "%s", msg);
         memmove(buf.data, r.p, r.left);
         buf.len = r.left;
         *result = buf;
-        return crc == CS_IMPORT_OK ? CS_IMPORT_OK : CS_IMPORT_BAD_INPUT;
+        return crc == CS_OK ? CS_OK : CS_ERR_BAD_INPUT;
     }
     cs_bytes_free(&buf);
     return rc;

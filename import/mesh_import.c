@@ -76,11 +76,11 @@ static int open_scene(const char *path, unsigned flags, bool join_unindexed,
     *out = NULL;
     if (!path || !*path) {
         set_err(err, errlen, "no mesh file given");
-        return CS_IMPORT_BAD_INPUT;
+        return CS_ERR_BAD_INPUT;
     }
     if (access(path, R_OK) != 0) {
         set_err(err, errlen, "cannot read %s: %s", path, strerror(errno));
-        return CS_IMPORT_BAD_INPUT;
+        return CS_ERR_BAD_INPUT;
     }
     FILE *f = fopen(path, "rb");
     if (!f || fgetc(f) == EOF) {
@@ -89,12 +89,12 @@ static int open_scene(const char *path, unsigned flags, bool join_unindexed,
         if (f)
             fclose(f);
         set_err(err, errlen, "cannot read %s: %s", path, e ? strerror(e) : "the file is empty");
-        return CS_IMPORT_BAD_INPUT;
+        return CS_ERR_BAD_INPUT;
     }
     fclose(f);
     cs_mesh_precheck_result pc;
     int rc = cs_mesh_precheck(path, &pc, err, errlen);
-    if (rc != CS_IMPORT_OK)
+    if (rc != CS_OK)
         return rc;
     /* no post-processing yet: it trusts face indices nothing has checked */
     const struct aiScene *scene =
@@ -105,9 +105,9 @@ static int open_scene(const char *path, unsigned flags, bool join_unindexed,
         const char *why = aiGetErrorString();
         set_err(err, errlen, "cannot read %s: %s", path,
                 why && *why ? why : "assimp could not import it");
-        return why && strstr(why, "bad_alloc") ? CS_IMPORT_NOMEM : CS_IMPORT_BAD_INPUT;
+        return why && strstr(why, "bad_alloc") ? CS_ERR_NOMEM : CS_ERR_BAD_INPUT;
     }
-    if ((rc = cs_mesh_check_scene(scene, path, err, errlen)) != CS_IMPORT_OK) {
+    if ((rc = cs_mesh_check_scene(scene, path, err, errlen)) != CS_OK) {
         aiReleaseImport(scene);
         return rc;
     }
@@ -117,15 +117,15 @@ static int open_scene(const char *path, unsigned flags, bool join_unindexed,
         const char *why = aiGetErrorString();   /* the scene is released */
         set_err(err, errlen, "cannot read %s: %s", path,
                 why && *why ? why : "assimp's post-processing failed");
-        return CS_IMPORT_BAD_INPUT;
+        return CS_ERR_BAD_INPUT;
     }
     if (!scene->mRootNode) {
         set_err(err, errlen, "cannot read %s: the file has no scene nodes", path);
         aiReleaseImport(scene);
-        return CS_IMPORT_BAD_INPUT;
+        return CS_ERR_BAD_INPUT;
     }
     *out = scene;
-    return CS_IMPORT_OK;
+    return CS_OK;
 }
 
 static void format_name(const struct aiScene *scene, const char *path, char *out, size_t len)
@@ -322,7 +322,7 @@ static int read_merged(const struct aiScene *scene, const char *path, const char
     walk_state st = {.scene = scene, .node = node, .bad_vertex = -1, .keep_points = keep_points};
     walk(&st, scene->mRootNode, identity, node == NULL, 0);
     *file_nodes = st.nodes;
-    int rc = CS_IMPORT_BAD_INPUT;
+    int rc = CS_ERR_BAD_INPUT;
     double *x = NULL;
     int *tri = NULL;
     if (st.too_deep) {
@@ -363,7 +363,7 @@ static int read_merged(const struct aiScene *scene, const char *path, const char
     tri = malloc((3 * (size_t)st.nt + 1) * sizeof *tri);
     if (!x || !tri) {
         set_err(err, errlen, "%s: out of memory for %ld vertices", path, st.nv);
-        rc = CS_IMPORT_NOMEM;
+        rc = CS_ERR_NOMEM;
         goto fail;
     }
     long nv = st.nv, nt = st.nt;
@@ -377,7 +377,7 @@ static int read_merged(const struct aiScene *scene, const char *path, const char
     *tri_out = tri;
     *nv_out = nv;
     *nt_out = nt;
-    return CS_IMPORT_OK;
+    return CS_OK;
 fail:
     free(x);
     free(tri);
@@ -431,7 +431,7 @@ static int read_in_child(void *ctx, cs_bytes *out, char *err, size_t errlen)
     const char *path = q->path;
     const struct aiScene *scene;
     int rc = open_scene(path, aiProcess_Triangulate, true, &scene, err, errlen);
-    for (int i = 0; i < q->n && rc == CS_IMPORT_OK; i++) {
+    for (int i = 0; i < q->n && rc == CS_OK; i++) {
         double *x = NULL;
         int *tri = NULL;
         long nv = 0, nt = 0;
@@ -439,12 +439,12 @@ static int read_in_child(void *ctx, cs_bytes *out, char *err, size_t errlen)
         walk_state st;
         rc = read_merged(scene, path, q->names ? q->names[i] : NULL, true, &x, &nv, &tri, &nt,
                          &nodes, &st, err, errlen);
-        if (rc == CS_IMPORT_OK && st.bad_vertex >= 0) {
+        if (rc == CS_OK && st.bad_vertex >= 0) {
             set_err(err, errlen, "%s: vertex %d has a non-finite coordinate", path,
                     st.bad_vertex);
-            rc = CS_IMPORT_BAD_INPUT;
+            rc = CS_ERR_BAD_INPUT;
         }
-        if (rc == CS_IMPORT_OK)
+        if (rc == CS_OK)
             put_mesh(out, &(cs_trimesh){(int)nv, (int)nt, x, tri});
         free(x);
         free(tri);
@@ -463,14 +463,14 @@ static int read_meshes(const read_request *q, cs_trimesh **out, char *err, size_
     int rc = cs_guard_run(q->path, read_in_child, (void *)q, &res, err, errlen);
     cs_bytes_reader r = {res.data, res.len, false};
     for (int i = 0; i < q->n; i++) {
-        out[i] = rc == CS_IMPORT_OK ? get_mesh(&r) : NULL;
-        if (rc == CS_IMPORT_OK && !out[i]) {
+        out[i] = rc == CS_OK ? get_mesh(&r) : NULL;
+        if (rc == CS_OK && !out[i]) {
             set_err(err, errlen, "%s: out of memory", q->path);
-            rc = CS_IMPORT_NOMEM;
+            rc = CS_ERR_NOMEM;
         }
     }
     cs_bytes_free(&res);
-    for (int i = 0; rc != CS_IMPORT_OK && i < q->n; i++) {
+    for (int i = 0; rc != CS_OK && i < q->n; i++) {
         cs_trimesh_destroy(out[i]);
         out[i] = NULL;
     }
@@ -531,7 +531,7 @@ static int import_in_child(void *ctx, cs_bytes *out, char *err, size_t errlen)
      * check, and degenerate triangles are counted. */
     const struct aiScene *scene = NULL;
     int rc = open_scene(path, aiProcess_Triangulate, false, &scene, err, errlen);
-    if (rc != CS_IMPORT_OK)
+    if (rc != CS_OK)
         goto done;
     format_name(scene, path, r.format, sizeof r.format);
     r.file_meshes = (int)scene->mNumMeshes;
@@ -548,9 +548,9 @@ static int import_in_child(void *ctx, cs_bytes *out, char *err, size_t errlen)
     walk_state st;
     rc = read_merged(scene, path, p->node, false, &x, &nv, &tri, &nt, &r.file_nodes, &st, err,
                      errlen);
-    if (rc != CS_IMPORT_OK)
+    if (rc != CS_OK)
         goto done;
-    rc = CS_IMPORT_BAD_INPUT;
+    rc = CS_ERR_BAD_INPUT;
     r.instances = (int)st.instances;
     r.triangles_read = nt;
     r.skipped_primitives = st.skipped;
@@ -570,7 +570,7 @@ static int import_in_child(void *ctx, cs_bytes *out, char *err, size_t errlen)
     }
     if (!(m = cs_mesh_clean(x, (int)nv, tri, (int)nt, &r))) {
         set_err(err, errlen, "%s: out of memory", path);
-        rc = CS_IMPORT_NOMEM;
+        rc = CS_ERR_NOMEM;
         goto done;
     }
     int kept = (int)nv - r.welded_vertices;
@@ -589,10 +589,10 @@ static int import_in_child(void *ctx, cs_bytes *out, char *err, size_t errlen)
     cs_mesh_analyse(m, &r);
     if (unitless)
         check_size(&r, r.size_warning, sizeof r.size_warning);
-    rc = CS_IMPORT_OK;
+    rc = CS_OK;
 done:
     cs_bytes_put(out, &r, sizeof r);
-    if (rc == CS_IMPORT_OK)
+    if (rc == CS_OK)
         put_mesh(out, m);
     cs_trimesh_destroy(m);
     free(x);
@@ -616,9 +616,9 @@ int cs_mesh_import(const char *path, const cs_mesh_placement *place, cs_trimesh 
     cs_bytes_reader rd = {res.data, res.len, false};
     if (res.len)
         cs_bytes_get(&rd, r, sizeof *r);
-    if (rc == CS_IMPORT_OK && !(*out = get_mesh(&rd))) {
+    if (rc == CS_OK && !(*out = get_mesh(&rd))) {
         set_err(err, errlen, "%s: out of memory", path);
-        rc = CS_IMPORT_NOMEM;
+        rc = CS_ERR_NOMEM;
     }
     cs_bytes_free(&res);
     return rc;
@@ -663,7 +663,7 @@ static int catalog_in_child(void *ctx, cs_bytes *out, char *err, size_t errlen)
     const char *path = ctx;
     const struct aiScene *scene;
     int rc = open_scene(path, aiProcess_Triangulate, false, &scene, err, errlen);
-    if (rc != CS_IMPORT_OK)
+    if (rc != CS_OK)
         return rc;
     char format[64];
     format_name(scene, path, format, sizeof format);
@@ -682,7 +682,7 @@ static int catalog_in_child(void *ctx, cs_bytes *out, char *err, size_t errlen)
         cs_bytes_put(out, c, sizeof c);
     }
     aiReleaseImport(scene);
-    return CS_IMPORT_OK;
+    return CS_OK;
 }
 
 /* A count of records of at least min bytes each that the reader can hold. */
@@ -733,7 +733,7 @@ int cs_mesh_catalog_read(const char *path, cs_mesh_catalog **out, char *err, siz
     *out = NULL;
     cs_bytes res;
     int rc = cs_guard_run(path, catalog_in_child, (void *)path, &res, err, errlen);
-    if (rc != CS_IMPORT_OK) {
+    if (rc != CS_OK) {
         cs_bytes_free(&res);
         return rc;
     }
@@ -744,7 +744,7 @@ int cs_mesh_catalog_read(const char *path, cs_mesh_catalog **out, char *err, siz
     } else {
         cs_mesh_catalog_destroy(c);
         set_err(err, errlen, "%s: out of memory", path);
-        rc = CS_IMPORT_NOMEM;
+        rc = CS_ERR_NOMEM;
     }
     cs_bytes_free(&res);
     return rc;

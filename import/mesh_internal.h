@@ -52,7 +52,7 @@ const void *cs_bytes_take(cs_bytes_reader *r, size_t n);
 
 /* ------------------------------------------------------------- guard */
 
-/* Work to do in the child: fills out and returns a CS_IMPORT_* status with
+/* Work to do in the child: fills out and returns a cs_status with
  * a sentence in err on failure. */
 typedef int (*cs_guarded_fn)(void *ctx, cs_bytes *out, char *err, size_t errlen);
 
@@ -60,7 +60,7 @@ typedef int (*cs_guarded_fn)(void *ctx, cs_bytes *out, char *err, size_t errlen)
  * time (sized from the size of the file at path), and returns its status
  * with what it wrote in *result, on failure too (free it with
  * cs_bytes_free). A child that crashes, runs out of time or memory, or
- * answers nonsense is CS_IMPORT_BAD_INPUT with err saying which, and an
+ * answers nonsense is CS_ERR_BAD_INPUT with err saying which, and an
  * empty result. CLOTHSIM_IMPORT_ISOLATION=0 runs fn in this process. */
 int cs_guard_run(const char *path, cs_guarded_fn fn, void *ctx, cs_bytes *result, char *err,
                  size_t errlen);
@@ -96,7 +96,7 @@ typedef struct cs_mesh_precheck_result {
  * element, ASCII PLY line by line) and its face indices; numbers in text
  * files of at most CS_MESH_MAX_NUMBER_DIGITS digits. A binary PLY that assimp 5.2
  * would misread (data starting with a line feed) gets a corrected copy in
- * res->data. CS_IMPORT_OK, or CS_IMPORT_BAD_INPUT with err. */
+ * res->data. CS_OK, or CS_ERR_BAD_INPUT with err. */
 int cs_mesh_precheck(const char *path, cs_mesh_precheck_result *res, char *err, size_t errlen);
 
 /* What assimp's post-processing would trust in an imported scene: face

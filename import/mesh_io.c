@@ -339,14 +339,14 @@ int cs_mesh_write(const char *path, cs_mesh_format format, int nmeshes,
 {
     if (!path || !*path) {
         set_err(err, errlen, "cs_mesh_write: no file name given");
-        return CS_IMPORT_BAD_INPUT;
+        return CS_ERR_BAD_INPUT;
     }
     if ((int)format < 0 || (int)format >= NFORMATS) {
         set_err(err, errlen, "%s: unknown mesh format %d", path, (int)format);
-        return CS_IMPORT_BAD_INPUT;
+        return CS_ERR_BAD_INPUT;
     }
     if (!check_views(path, nmeshes, meshes, err, errlen))
-        return CS_IMPORT_BAD_INPUT;
+        return CS_ERR_BAD_INPUT;
 
     bool points_only = format == CS_MESH_PLY;
     for (int m = 0; m < nmeshes; m++)
@@ -356,7 +356,7 @@ int cs_mesh_write(const char *path, cs_mesh_format format, int nmeshes,
     if (points_only ? !ply_points(nmeshes, meshes, &points) : !scene) {
         cs_bytes_free(&points);
         set_err(err, errlen, "%s: out of memory", path);
-        return CS_IMPORT_NOMEM;
+        return CS_ERR_NOMEM;
     }
     /* Assimp exports into memory and the bytes are written here, every
      * write checked: assimp's own file writer ignores a short fwrite and
@@ -367,13 +367,13 @@ int cs_mesh_write(const char *path, cs_mesh_format format, int nmeshes,
     const void *data = blob ? blob->data : points.data;
     size_t size = blob ? blob->size : points.len;
 
-    int status = CS_IMPORT_OK;
+    int status = CS_OK;
     if (!data || size == 0) {
         set_err(err, errlen, "cannot write %s: assimp's '%s' exporter failed",
                 path, FORMATS[format].assimp_id);
-        status = CS_IMPORT_BAD_INPUT;
+        status = CS_ERR_BAD_INPUT;
     } else if (cs_file_write_atomic(path, data, size, err, errlen) != 0) {
-        status = CS_IMPORT_BAD_INPUT;
+        status = CS_ERR_BAD_INPUT;
     }
     if (blob)
         aiReleaseExportBlob(blob);

@@ -21,7 +21,7 @@ int cs_sl_convert_motion(loader *L, const cs_raw_motion *rm, const char *path, c
     memcpy(m->position, pos, sizeof m->position);
     memcpy(m->rotation, rot, sizeof m->rotation);
     if (!rm)
-        return CS_IMPORT_OK;
+        return CS_OK;
     bool constant = rm->velocity || rm->angular_velocity;
     if (constant && rm->keys)
         return cs_sl_fail(L, path, false,
@@ -34,10 +34,10 @@ int cs_sl_convert_motion(loader *L, const cs_raw_motion *rm, const char *path, c
                          m->angular_velocity);
     }
     if (!rm->keys)
-        return CS_IMPORT_OK;
+        return CS_OK;
     cs_keyframe *keys = calloc(rm->keys_count, sizeof *keys);
     if (!keys)
-        return CS_IMPORT_NOMEM;
+        return CS_ERR_NOMEM;
     m->kind = CS_MOTION_KEYFRAMES;
     m->keys = keys; /* owned by the scene from here on */
     m->nkeys = (int)rm->keys_count;
@@ -59,7 +59,7 @@ int cs_sl_convert_motion(loader *L, const cs_raw_motion *rm, const char *path, c
         cs_quat_from_euler_degrees(deg, q);
         cs_quat_multiply(q, rot, keys[k].rotation);
     }
-    return CS_IMPORT_OK;
+    return CS_OK;
 }
 
 /* ---------------------------------------------------------- selections */
@@ -78,8 +78,8 @@ static int select_vertices(loader *L, const cs_raw_selection *sel, const char *p
                           "expected exactly one of vertices, box or grid_points (got %d)", forms);
     unsigned char *mark = calloc((size_t)mesh->nv, 1);
     if (!mark)
-        return CS_IMPORT_NOMEM;
-    int rc = CS_IMPORT_OK;
+        return CS_ERR_NOMEM;
+    int rc = CS_OK;
     const char *form = "vertices";
     if (sel->vertices) {
         for (unsigned i = 0; i < sel->vertices_count && !rc; i++) {
@@ -134,7 +134,7 @@ static int select_vertices(loader *L, const cs_raw_selection *sel, const char *p
     if (!rc) {
         *out = malloc((size_t)n * sizeof **out);
         if (!*out)
-            rc = CS_IMPORT_NOMEM;
+            rc = CS_ERR_NOMEM;
         for (int v = 0; v < mesh->nv && *out; v++)
             if (mark[v])
                 (*out)[(*nout)++] = v;
@@ -157,17 +157,17 @@ static int convert_scripts(loader *L, const cs_raw_cloth *rc, const char *base, 
 {
     const cs_trimesh *mesh = cd->mesh;
     char p[PATH_LEN];
-    int err = CS_IMPORT_OK;
+    int err = CS_OK;
     int nscripts = (rc->pins_count > 0) + (int)rc->scripts_count;
     if (nscripts == 0)
-        return CS_IMPORT_OK;
+        return CS_OK;
     cs_vertex_script *scripts = calloc((size_t)nscripts, sizeof *scripts);
     /* Who holds each vertex: 0 nobody, -(p+1) pin p, s+1 script s. */
     int *holder = calloc((size_t)mesh->nv, sizeof *holder);
     if (!scripts || !holder) {
         free(scripts);
         free(holder);
-        return CS_IMPORT_NOMEM;
+        return CS_ERR_NOMEM;
     }
     cd->scripts = scripts;
     cd->nscripts = nscripts;
@@ -189,7 +189,7 @@ static int convert_scripts(loader *L, const cs_raw_cloth *rc, const char *base, 
         }
         int *all = err ? NULL : malloc((size_t)npinned * sizeof *all);
         if (!err && !all)
-            err = CS_IMPORT_NOMEM;
+            err = CS_ERR_NOMEM;
         if (!err) {
             int n = 0;
             for (int v = 0; v < mesh->nv; v++)
@@ -281,7 +281,7 @@ static int convert_grid(loader *L, const cs_raw_grid *g, const char *base, int r
     cs_quat_from_euler_degrees(deg, q);
     *mesh = cs_trimesh_create_grid(size, res, q, center);
     L->particles = all;
-    return *mesh ? CS_IMPORT_OK : CS_IMPORT_NOMEM;
+    return *mesh ? CS_OK : CS_ERR_NOMEM;
 }
 
 static const char *cloth_name(const cs_scene *s, int j)
@@ -318,7 +318,7 @@ int cs_sl_convert_cloth(loader *L, const cs_raw_cloth *rc, int ci, cs_scene *s)
         char who[128];
         snprintf(who, sizeof who, "%s '%.60s'", base, cd->name);
         if (!cs_sl_note_mesh(s, who, file, &report, false))
-            err = CS_IMPORT_NOMEM;
+            err = CS_ERR_NOMEM;
     }
     free(file);
     if (err)

@@ -44,7 +44,7 @@ int cs_sl_num(loader *L, const cs_scene_key *k, const double *v, const char *bas
         return fail_range(L, p, &k->range);
     }
     *out = v ? *v : key_default(k, 0);
-    return CS_IMPORT_OK;
+    return CS_OK;
 }
 
 int cs_sl_int(loader *L, const cs_scene_key *k, const int *v, const char *base, int index, int *out)
@@ -60,7 +60,7 @@ int cs_sl_int(loader *L, const cs_scene_key *k, const int *v, const char *base, 
         return cs_sl_fail(L, p, true, "must be at most %d", (int)r->hi);
     }
     *out = v ? *v : (int)key_default(k, index < 0 ? 0 : index);
-    return CS_IMPORT_OK;
+    return CS_OK;
 }
 
 int cs_sl_vec(loader *L, const cs_scene_key *k, const double *v, const char *base,
@@ -74,12 +74,12 @@ int cs_sl_vec(loader *L, const cs_scene_key *k, const double *v, const char *bas
         }
         out[i] = v ? v[i] : def ? def[i] : key_default(k, i);
     }
-    return CS_IMPORT_OK;
+    return CS_OK;
 }
 
 int cs_sl_convert_keys(loader *L, int section, const void *raw, const char *base, void *target)
 {
-    int rc = CS_IMPORT_OK;
+    int rc = CS_OK;
     for (int i = 0; i < CS_KEY_COUNT && !rc; i++) {
         const cs_scene_key *k = &cs_scene_keys[i];
         if (k->section != section || k->target < 0)
@@ -104,7 +104,7 @@ int cs_sl_check_name(loader *L, const char *name, const char *path)
 {
     if (name && !*name)
         return cs_sl_fail(L, path, false, "must not be empty");
-    return CS_IMPORT_OK;
+    return CS_OK;
 }
 
 int cs_sl_entry_name(loader *L, const char *given, const char *list, const char *stem, int index,
@@ -118,12 +118,12 @@ int cs_sl_entry_name(loader *L, const char *given, const char *list, const char 
         return err;
     snprintf(fallback, sizeof fallback, "%s%d", stem, index);
     if (!(*out = cs_sl_strdup(given ? given : fallback)))
-        return CS_IMPORT_NOMEM;
+        return CS_ERR_NOMEM;
     for (int j = 0; j < index; j++)
         if (!strcmp(before(s, j), *out))
             return cs_sl_fail(L, given ? p : base, false,
                               "must differ from the name of %s[%d] (got %s)", list, j, *out);
-    return CS_IMPORT_OK;
+    return CS_OK;
 }
 
 char *cs_sl_strdup(const char *s)
@@ -179,7 +179,7 @@ static int unused(loader *L, const void *given, const char *base, const char *ke
 {
     char p[PATH_LEN];
     if (!given)
-        return CS_IMPORT_OK;
+        return CS_OK;
     snprintf(p, sizeof p, "%s.%s", base, key);
     return cs_sl_fail(L, p, false, "is not used by a %s (remove it)",
                       cs_scene_enum_name(CS_SKEY(body, shape), shape));
@@ -189,7 +189,7 @@ static int required(loader *L, const void *given, const char *base, const char *
 {
     char p[PATH_LEN];
     if (given)
-        return CS_IMPORT_OK;
+        return CS_OK;
     snprintf(p, sizeof p, "%s.%s", base, key);
     return cs_sl_fail(L, p, false, "is required for a %s",
                       cs_scene_enum_name(CS_SKEY(body, shape), shape));
@@ -211,7 +211,7 @@ static int convert_friction_keys(loader *L, const cs_raw_body *rb, const char *b
     int err;
     bd->nfriction_keys = 0;
     if (!rb->friction_keys)
-        return CS_IMPORT_OK;
+        return CS_OK;
     snprintf(p, sizeof p, "%s.friction_keys", base);
     if (rb->friction)
         return cs_sl_fail(L, p, false, "expected either friction or friction_keys (got both)");
@@ -233,7 +233,7 @@ static int convert_friction_keys(loader *L, const cs_raw_body *rb, const char *b
         bd->friction_keys[k].time = rk->time;
     }
     bd->nfriction_keys = (int)rb->friction_keys_count;
-    return CS_IMPORT_OK;
+    return CS_OK;
 }
 
 static int convert_body(loader *L, const cs_raw_body *rb, int bi, cs_scene *s)
@@ -332,7 +332,7 @@ static int convert_time(loader *L, const cs_raw_time *t, cs_scene *s)
             return cs_sl_fail(L, "time.dt", true, "expected a number %s or auto", text);
     }
     s->def.dt = dt;
-    return CS_IMPORT_OK;
+    return CS_OK;
 }
 
 static int convert_camera(loader *L, const cs_raw_camera *c, cs_camera_def *cam)
@@ -381,7 +381,7 @@ int cs_sl_convert_scene(loader *L, const cs_raw_scene *r, const char *default_na
     cs_scene *s = calloc(1, sizeof *s);
     *out = NULL;
     if (!s)
-        return CS_IMPORT_NOMEM;
+        return CS_ERR_NOMEM;
     s->def = cs_default_sim_def();
     s->def.cloths = NULL;
     s->def.ncloths = 0;
@@ -452,9 +452,9 @@ int cs_sl_convert_scene(loader *L, const cs_raw_scene *r, const char *default_na
     s->levelset_cache = cs_levelset_cache_dir(r->levelset ? r->levelset->cache : NULL, dir);
     free(dir);
     *out = s;
-    return CS_IMPORT_OK;
+    return CS_OK;
 nomem:
-    rc = CS_IMPORT_NOMEM;
+    rc = CS_ERR_NOMEM;
 fail:
     cs_scene_destroy(s);
     return rc;

@@ -303,7 +303,7 @@ static int by_hand(emitter *m, int sec, const cs_scene_key *k, const void *raw)
         char p[PATH_LEN + 8];
         double scale[3];
         snprintf(p, sizeof p, "%s.%s", m->path, k->key);
-        if (cs_sl_read_scale(m->L, p, scale) != CS_IMPORT_OK)
+        if (cs_sl_read_scale(m->L, p, scale) != CS_OK)
             m->failed = true;
         scalar(m, k->key, false);
         numbers(m, scale, 3);
@@ -400,7 +400,7 @@ static int emit(loader *L, const cs_raw_scene *r, cs_scene *s, bool frames, char
     emitter *m = calloc(1, sizeof *m);
     if (!m || !yaml_emitter_initialize(&m->e)) {
         free(m);
-        return CS_IMPORT_NOMEM;
+        return CS_ERR_NOMEM;
     }
     m->L = L;
     m->s = s;
@@ -416,10 +416,10 @@ static int emit(loader *L, const cs_raw_scene *r, cs_scene *s, bool frames, char
     put(m, &ev, yaml_document_end_event_initialize(&ev, 1));
     put(m, &ev, yaml_stream_end_event_initialize(&ev));
     yaml_emitter_delete(&m->e);
-    int rc = m->failed ? (L->err_msg[0] ? CS_IMPORT_BAD_INPUT : CS_IMPORT_NOMEM) : CS_IMPORT_OK;
-    *text = rc == CS_IMPORT_OK ? m->buf : NULL;
-    *len = rc == CS_IMPORT_OK ? m->len : 0;
-    if (rc != CS_IMPORT_OK)
+    int rc = m->failed ? (L->err_msg[0] ? CS_ERR_BAD_INPUT : CS_ERR_NOMEM) : CS_OK;
+    *text = rc == CS_OK ? m->buf : NULL;
+    *len = rc == CS_OK ? m->len : 0;
+    if (rc != CS_OK)
         free(m->buf);
     free(m);
     return rc;
@@ -429,17 +429,17 @@ int cs_sl_resolve(loader *L, const cs_raw_scene *r, cs_scene *s)
 {
     L->err_msg[0] = '\0';
     int rc = emit(L, r, s, true, &s->resolved, &s->resolved_len);
-    if (rc == CS_IMPORT_OK)
+    if (rc == CS_OK)
         rc = emit(L, r, s, false, &s->resolved_setup, &s->resolved_setup_len);
     /* the grids the scene used, already named by their content */
-    for (int b = 0; rc == CS_IMPORT_OK && s->mesh_bodies && b < s->def.nbodies; b++) {
+    for (int b = 0; rc == CS_OK && s->mesh_bodies && b < s->def.nbodies; b++) {
         const char *cached = s->mesh_bodies[b].cache_path;
         char name[PATH_LEN + 16];
         if (!cached)
             continue;
         snprintf(name, sizeof name, "%s/%s", ASSETS, cs_sl_base_name(cached));
         if (!add_asset(s, cached, name))
-            rc = CS_IMPORT_NOMEM;
+            rc = CS_ERR_NOMEM;
     }
     return rc;
 }

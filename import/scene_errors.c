@@ -54,7 +54,7 @@ int cs_sl_fail_at(loader *L, const cs_spath *p, bool with_got, const char *fmt, 
             snprintf(L->err_msg + used, sizeof L->err_msg - used, " (got %s)", got);
         }
     }
-    return CS_IMPORT_BAD_INPUT;
+    return CS_ERR_BAD_INPUT;
 }
 
 int cs_sl_fail(loader *L, const char *path, bool with_got, const char *fmt, ...)
@@ -132,7 +132,7 @@ int cs_sl_report(loader *L, bool blame, char *err, size_t errlen)
     else
         cs_sl_set_err(err, errlen, "%s:%d: %s%s%s", L->file, loc.line, path, *path ? ": " : "",
                       L->err_msg);
-    return CS_IMPORT_BAD_INPUT;
+    return CS_ERR_BAD_INPUT;
 }
 
 /* ---------------------------------------------------------- cyaml stage */
@@ -238,7 +238,7 @@ static int translate_cyaml(loader *L, cyaml_err_t e)
     if (starts(what, "Mapping field already seen: ")) {
         cs_sl_fail_at(L, &p, false, "duplicate key");
         L->err_second = true;
-        return CS_IMPORT_BAD_INPUT;
+        return CS_ERR_BAD_INPUT;
     }
     if (count) {
         const cyaml_schema_value_t *v = cs_scene_schema_at(&p);
@@ -283,7 +283,7 @@ int cs_sl_check_scalar(loader *L, const yaml_node_t *n, const cyaml_schema_value
             return cs_sl_fail_at(L, p, true, "expected a number");
         if (!isfinite(x))
             return cs_sl_fail_at(L, p, true, "expected a finite number");
-        return CS_IMPORT_OK;
+        return CS_OK;
     }
     case CYAML_INT: {
         const char *d = s + (*s == '-' || *s == '+');
@@ -295,29 +295,29 @@ int cs_sl_check_scalar(loader *L, const yaml_node_t *n, const cyaml_schema_value
         /* cyaml reads "010" as octal 8. */
         if (d[0] == '0' && d[1] != '\0')
             return cs_sl_fail_at(L, p, true, "expected an integer without leading zeros");
-        return CS_IMPORT_OK;
+        return CS_OK;
     }
     case CYAML_BOOL:
         /* cyaml takes anything but false/no/disable/0 as true ("off" too). */
         if (strcasecmp(s, "true") && strcasecmp(s, "false") && strcasecmp(s, "yes") &&
             strcasecmp(s, "no"))
             return cs_sl_fail_at(L, p, true, "expected true or false");
-        return CS_IMPORT_OK;
-    default: return CS_IMPORT_OK;
+        return CS_OK;
+    default: return CS_OK;
     }
 }
 
 static int check_scalars(loader *L, int id, const cyaml_schema_value_t *v, cs_spath *p)
 {
     const yaml_node_t *n = yaml_document_get_node(&L->doc.doc, id);
-    int rc = CS_IMPORT_OK;
+    int rc = CS_OK;
     if (!n || !v)
-        return CS_IMPORT_OK;
+        return CS_OK;
     if (n->type == YAML_SCALAR_NODE)
         return cs_sl_check_scalar(L, n, v, p);
     if (n->type == YAML_MAPPING_NODE && v->type == CYAML_MAPPING) {
         long npairs = n->data.mapping.pairs.top - n->data.mapping.pairs.start;
-        for (long i = 0; rc == CS_IMPORT_OK && i < npairs; i++) {
+        for (long i = 0; rc == CS_OK && i < npairs; i++) {
             yaml_node_pair_t pair = n->data.mapping.pairs.start[i];
             const yaml_node_t *k = yaml_document_get_node(&L->doc.doc, pair.key);
             if (!k || k->type != YAML_SCALAR_NODE || p->n >= CS_SPATH_MAX)
@@ -334,7 +334,7 @@ static int check_scalars(loader *L, int id, const cyaml_schema_value_t *v, cs_sp
     } else if (n->type == YAML_SEQUENCE_NODE &&
                (v->type == CYAML_SEQUENCE || v->type == CYAML_SEQUENCE_FIXED)) {
         long nitems = n->data.sequence.items.top - n->data.sequence.items.start;
-        for (long i = 0; rc == CS_IMPORT_OK && i < nitems; i++) {
+        for (long i = 0; rc == CS_OK && i < nitems; i++) {
             if (p->n >= CS_SPATH_MAX)
                 break;
             cs_spath_push_index(p, i);
@@ -366,7 +366,7 @@ int cs_sl_load_raw(loader *L, const char *text, size_t len, cs_raw_scene **raw)
     cyaml_err_t e = cyaml_load_data((const uint8_t *)text, len, cyaml_config_for(L, &cfg),
                                     &cs_scene_schema, (cyaml_data_t **)raw, NULL);
     if (e == CYAML_ERR_OOM)
-        return CS_IMPORT_NOMEM;
+        return CS_ERR_NOMEM;
     if (e != CYAML_OK)
         return translate_cyaml(L, e);
     if (!*raw)

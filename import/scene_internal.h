@@ -51,7 +51,7 @@ typedef struct loader {
 void cs_sl_set_err(char *err, size_t errlen, const char *fmt, ...)
     __attribute__((format(printf, 3, 4)));
 /* Records the pending error at a key path; with_got appends "(got X)" with
- * the value found there. Return CS_IMPORT_BAD_INPUT. */
+ * the value found there. Return CS_ERR_BAD_INPUT. */
 int cs_sl_fail_at(loader *L, const cs_spath *p, bool with_got, const char *fmt, ...)
     __attribute__((format(printf, 4, 5)));
 int cs_sl_fail(loader *L, const char *path, bool with_got, const char *fmt, ...)

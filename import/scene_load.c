@@ -20,7 +20,7 @@ static int apply_overrides(loader *L, cs_raw_scene *raw, char *err, size_t errle
         cs_spath p;
         if (!eq) {
             cs_sl_set_err(err, errlen, "--set %s: expected PATH=VALUE", ov ? ov : "(null)");
-            return CS_IMPORT_BAD_INPUT;
+            return CS_ERR_BAD_INPUT;
         }
         char path[PATH_LEN];
         size_t n = (size_t)(eq - ov);
@@ -28,21 +28,21 @@ static int apply_overrides(loader *L, cs_raw_scene *raw, char *err, size_t errle
             cs_sl_set_err(
                 err, errlen,
                 "--set %s: expected a key path like cloths.0.material.node_mass before '='", ov);
-            return CS_IMPORT_BAD_INPUT;
+            return CS_ERR_BAD_INPUT;
         }
         int rc = cs_sdoc_set(&L->doc, &p, eq + 1, k, msg, sizeof msg);
         if (rc == CS_SDOC_NOMEM)
-            return CS_IMPORT_NOMEM;
+            return CS_ERR_NOMEM;
         if (rc != CS_SDOC_OK) {
             cs_sl_set_err(err, errlen, "--set %s: %s", ov, msg);
-            return CS_IMPORT_BAD_INPUT;
+            return CS_ERR_BAD_INPUT;
         }
-        if ((rc = cs_sl_apply_override(L, raw, &p)) != CS_IMPORT_OK)
-            return rc == CS_IMPORT_BAD_INPUT ? cs_sl_report(L, true, err, errlen) : rc;
+        if ((rc = cs_sl_apply_override(L, raw, &p)) != CS_OK)
+            return rc == CS_ERR_BAD_INPUT ? cs_sl_report(L, true, err, errlen) : rc;
     }
     cs_spath top = {0};
     int rc = cs_sl_check_required(L, CS_SEC_scene, raw, &top);
-    return rc == CS_IMPORT_BAD_INPUT ? cs_sl_report(L, true, err, errlen) : rc;
+    return rc == CS_ERR_BAD_INPUT ? cs_sl_report(L, true, err, errlen) : rc;
 }
 
 /* The merged scene failed to convert. Errors in nodes an override made are
@@ -62,13 +62,13 @@ static int report_merged(loader *L, const char *text, size_t len, const char *de
     cs_raw_scene *orig = NULL;
     cs_scene *alone = NULL;
     int rc = cs_sl_load_raw(L, text, len, &orig);
-    if (rc == CS_IMPORT_OK)
+    if (rc == CS_OK)
         rc = cs_sl_convert_scene(L, orig, default_name, &alone);
     cs_scene_destroy(alone);
     cs_sl_free_raw(L, orig);
-    if (rc == CS_IMPORT_NOMEM)
+    if (rc == CS_ERR_NOMEM)
         return rc;
-    if (rc == CS_IMPORT_BAD_INPUT) {
+    if (rc == CS_ERR_BAD_INPUT) {
         cs_sdoc_locate(&L->doc, &L->err_path, false, &loc);
         if (loc.owner < 0)
             return cs_sl_report(L, false, err, errlen);
@@ -88,7 +88,7 @@ static int load(const char *text, size_t len, const char *file, const char *defa
     int line = 1, rc;
 
     if (!L)
-        return CS_IMPORT_NOMEM;
+        return CS_ERR_NOMEM;
     L->file = file;
     L->noverrides = overrides ? noverrides : 0;
     L->overrides = overrides;
@@ -96,36 +96,36 @@ static int load(const char *text, size_t len, const char *file, const char *defa
     rc = cs_sdoc_load(&L->doc, text, len, &line, msg, sizeof msg);
     if (rc == CS_SDOC_BAD) {
         cs_sl_set_err(err, errlen, "%s:%d: %s", file, line, msg);
-        rc = CS_IMPORT_BAD_INPUT;
+        rc = CS_ERR_BAD_INPUT;
     } else if (rc == CS_SDOC_NOMEM) {
-        rc = CS_IMPORT_NOMEM;
+        rc = CS_ERR_NOMEM;
     } else if (!cs_sdoc_root(&L->doc)) {
         cs_sl_set_err(err, errlen,
                       "%s:1: the scene is empty (expected a mapping with at least cloths)", file);
-        rc = CS_IMPORT_BAD_INPUT;
-    } else if ((rc = cs_sl_load_raw(L, text, len, &raw)) == CS_IMPORT_BAD_INPUT) {
+        rc = CS_ERR_BAD_INPUT;
+    } else if ((rc = cs_sl_load_raw(L, text, len, &raw)) == CS_ERR_BAD_INPUT) {
         rc = cs_sl_report(L, false, err, errlen);
-    } else if (rc == CS_IMPORT_OK && L->noverrides > 0) {
+    } else if (rc == CS_OK && L->noverrides > 0) {
         rc = apply_overrides(L, raw, err, errlen);
-        if (rc == CS_IMPORT_OK) {
+        if (rc == CS_OK) {
             rc = cs_sl_convert_scene(L, raw, default_name, out);
-            if (rc == CS_IMPORT_BAD_INPUT)
+            if (rc == CS_ERR_BAD_INPUT)
                 rc = report_merged(L, text, len, default_name, err, errlen);
         }
-    } else if (rc == CS_IMPORT_OK) {
+    } else if (rc == CS_OK) {
         rc = cs_sl_convert_scene(L, raw, default_name, out);
-        if (rc == CS_IMPORT_BAD_INPUT)
+        if (rc == CS_ERR_BAD_INPUT)
             rc = cs_sl_report(L, false, err, errlen);
     }
-    if (rc == CS_IMPORT_OK && ((rc = cs_sl_build_levelsets(L, *out)) != CS_IMPORT_OK ||
+    if (rc == CS_OK && ((rc = cs_sl_build_levelsets(L, *out)) != CS_OK ||
                                (rc = cs_sl_resolve(L, raw, *out)) !=
-                                   CS_IMPORT_OK)) {
-        if (rc == CS_IMPORT_BAD_INPUT)
+                                   CS_OK)) {
+        if (rc == CS_ERR_BAD_INPUT)
             cs_sl_report(L, L->noverrides > 0, err, errlen);
         cs_scene_destroy(*out);
         *out = NULL;
     }
-    if (rc == CS_IMPORT_NOMEM)
+    if (rc == CS_ERR_NOMEM)
         cs_sl_set_err(err, errlen, "%s: out of memory", file);
     cs_sl_free_raw(L, raw);
     cs_sdoc_free(&L->doc);
@@ -137,11 +137,11 @@ int cs_scene_load_string(const char *text, const char *origin, int noverrides,
                          const char *const *overrides, cs_scene **out, char *err, size_t errlen)
 {
     if (!out)
-        return CS_IMPORT_BAD_INPUT;
+        return CS_ERR_BAD_INPUT;
     *out = NULL;
     if (!text) {
         cs_sl_set_err(err, errlen, "%s: no text", origin ? origin : "<string>");
-        return CS_IMPORT_BAD_INPUT;
+        return CS_ERR_BAD_INPUT;
     }
     return load(text, strlen(text), origin ? origin : "<string>", origin ? NULL : "scene",
                 noverrides, overrides, out, err, errlen);
@@ -191,16 +191,16 @@ int cs_scene_load(const char *path, int noverrides, const char *const *overrides
 {
     size_t len = 0;
     if (!out)
-        return CS_IMPORT_BAD_INPUT;
+        return CS_ERR_BAD_INPUT;
     *out = NULL;
     if (!path) {
         cs_sl_set_err(err, errlen, "no scene file given");
-        return CS_IMPORT_BAD_INPUT;
+        return CS_ERR_BAD_INPUT;
     }
     char *text = read_file(path, &len);
     if (!text) {
         cs_sl_set_err(err, errlen, "%s: cannot read: %s", path, strerror(errno));
-        return errno == ENOMEM ? CS_IMPORT_NOMEM : CS_IMPORT_BAD_INPUT;
+        return errno == ENOMEM ? CS_ERR_NOMEM : CS_ERR_BAD_INPUT;
     }
     /* libyaml would stop at a NUL byte without saying so. */
     if (strlen(text) != len) {
@@ -210,7 +210,7 @@ int cs_scene_load(const char *path, int noverrides, const char *const *overrides
         cs_sl_set_err(err, errlen, "%s:%d: the file contains a NUL byte (not a text file?)", path,
                       line);
         free(text);
-        return CS_IMPORT_BAD_INPUT;
+        return CS_ERR_BAD_INPUT;
     }
     int rc = load(text, len, path, NULL, noverrides, overrides, out, err, errlen);
     free(text);

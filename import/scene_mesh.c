@@ -89,13 +89,13 @@ int cs_sl_read_scale(loader *L, const char *path, double out[3])
     cs_sloc loc;
     out[0] = out[1] = out[2] = 1;
     if (!cs_spath_parse(&p, path))
-        return CS_IMPORT_OK;
+        return CS_OK;
     cs_sdoc_locate(&L->doc, &p, false, &loc);
     if (loc.matched != p.n || !loc.node)
-        return CS_IMPORT_OK;
+        return CS_OK;
     const yaml_node_t *n = yaml_document_get_node(&L->doc.doc, loc.node);
     if (!n)
-        return CS_IMPORT_OK;
+        return CS_OK;
     int items = 1;
     const yaml_node_item_t *item = NULL;
     if (n->type == YAML_SEQUENCE_NODE) {
@@ -123,7 +123,7 @@ int cs_sl_read_scale(loader *L, const char *path, double out[3])
         for (int d = item ? k : 0; d < (item ? k + 1 : 3); d++)
             out[d] = v;
     }
-    return CS_IMPORT_OK;
+    return CS_OK;
 }
 
 /* The placement keys of a mesh block. */
@@ -164,9 +164,9 @@ static int convert_mesh_file(loader *L, const cs_raw_mesh *m, const char *mp, cs
     if (!*m->file)
         return cs_sl_fail(L, p, false, "must not be empty");
     if (!(*file = cs_sl_scene_relative(L->file, m->file)))
-        return CS_IMPORT_NOMEM;
+        return CS_ERR_NOMEM;
     rc = cs_mesh_import(*file, &pl, mesh, rep, why, sizeof why);
-    if (rc == CS_IMPORT_BAD_INPUT) {
+    if (rc == CS_ERR_BAD_INPUT) {
         /* a node that is not there is the node key's fault */
         if (m->node && rep->format[0] && rep->instances == 0)
             snprintf(p, sizeof p, "%s.node", mp);
@@ -213,7 +213,7 @@ int cs_sl_convert_mesh(loader *L, const cs_raw_mesh *m, const char *base, cs_tri
         return rc;
     *mesh = cs_trimesh_create(nv, nt);
     if (!*mesh)
-        return CS_IMPORT_NOMEM;
+        return CS_ERR_NOMEM;
     for (int v = 0; v < nv; v++) {
         double sc[3], r[3];
         for (int k = 0; k < 3; k++)
@@ -228,7 +228,7 @@ int cs_sl_convert_mesh(loader *L, const cs_raw_mesh *m, const char *base, cs_tri
     snprintf(rep->format, sizeof rep->format, "inline");
     rep->unit_scale = 1;
     cs_mesh_analyse(*mesh, rep);
-    return CS_IMPORT_OK;
+    return CS_OK;
 }
 
 /* One line on what import did with a mesh file, and a warning for what the
@@ -281,7 +281,7 @@ int cs_sl_convert_mesh_body(loader *L, const cs_raw_body *rb, int bi, cs_scene *
     if ((err = cs_sl_convert_mesh(L, rb->mesh, base, &mb->mesh, &mb->report, &mb->file)))
         return err;
     if (!mb->file && !(mb->file = cs_sl_strdup("(inline)")))
-        return CS_IMPORT_NOMEM;
+        return CS_ERR_NOMEM;
     if (mb->mesh->nt == 0) {
         snprintf(p, sizeof p, "%s.mesh", base);
         return cs_sl_fail(L, p, false, "must have triangles for a body");
@@ -294,7 +294,7 @@ int cs_sl_convert_mesh_body(loader *L, const cs_raw_body *rb, int bi, cs_scene *
     mb->close_holes = rb->close_holes ? *rb->close_holes : CS_SKEY(body, close_holes)->def(0) != 0;
     mb->interior =
         (cs_interior_mode)(rb->interior ? *rb->interior : (int)CS_SKEY(body, interior)->def(0));
-    return CS_IMPORT_OK;
+    return CS_OK;
 }
 
 /* The median edge length over all cloths: what the default voxel size
@@ -350,12 +350,12 @@ int cs_sl_finish_mesh_bodies(loader *L, cs_scene *s)
         snprintf(base, sizeof base, "bodies[%d]", b);
         snprintf(who, sizeof who, "%s '%.60s'", base, s->def.bodies[b].name);
         if (strcmp(mb->file, "(inline)") && !cs_sl_note_mesh(s, who, mb->file, &mb->report, true))
-            return CS_IMPORT_NOMEM;
+            return CS_ERR_NOMEM;
         cs_mesh_report closed;
         cs_trimesh *sign = cs_mesh_body_sign_mesh(mb->mesh, &mb->report, mb->close_holes,
                                                   &mb->holes_closed, &closed);
         if (!sign)
-            return CS_IMPORT_NOMEM;
+            return CS_ERR_NOMEM;
         mb->sign_mesh = sign;
         if (!mb->report.closed) {
             bool ok;
@@ -381,7 +381,7 @@ int cs_sl_finish_mesh_bodies(loader *L, cs_scene *s)
                                 who, mb->holes_closed, mb->holes_closed == 1 ? "" : "s",
                                 closed.boundary_edges, closed.nonmanifold_edges);
             if (!ok)
-                return CS_IMPORT_NOMEM;
+                return CS_ERR_NOMEM;
         }
         bool given = mb->voxel_size > 0;
         if (!given && edge < 0)
@@ -396,7 +396,7 @@ int cs_sl_finish_mesh_bodies(loader *L, cs_scene *s)
             return cs_sl_fail(L, p, false, "the default voxel_size %.3g m %s", mb->voxel_size, why);
         }
     }
-    return CS_IMPORT_OK;
+    return CS_OK;
 }
 
 /* ------------------------------------------------------------ level sets */
@@ -425,9 +425,9 @@ int cs_sl_build_levelsets(loader *L, cs_scene *s)
         };
         cs_levelset_result res;
         int rc = cs_levelset_build(mb->sign_mesh, &req, &res, why, sizeof why);
-        if (rc != CS_IMPORT_OK) {
+        if (rc != CS_OK) {
             snprintf(p, sizeof p, "bodies[%d].mesh", b);
-            return rc == CS_IMPORT_NOMEM
+            return rc == CS_ERR_NOMEM
                        ? rc
                        : cs_sl_fail(L, p, false, "cannot make its level set: %s", why);
         }
@@ -435,7 +435,7 @@ int cs_sl_build_levelsets(loader *L, cs_scene *s)
         mb->from_cache = res.from_cache;
         mb->seconds = res.seconds;
         if (res.cache_path[0] && !(mb->cache_path = cs_sl_strdup(res.cache_path)))
-            return CS_IMPORT_NOMEM;
+            return CS_ERR_NOMEM;
         cs_levelset_attach((cs_body_def *)&s->def.bodies[b], mb->levelset);
         cs_levelset_info info;
         cs_levelset_get_info(mb->levelset, &info);
@@ -454,10 +454,10 @@ int cs_sl_build_levelsets(loader *L, cs_scene *s)
                         who, info.dim[0], info.dim[1], info.dim[2], info.voxel_size, mb->grid_band,
                         mb->fill_interior ? ", interior filled" : "", info.active_voxels,
                         info.memory_bytes / 1e6, done))
-            return CS_IMPORT_NOMEM;
+            return CS_ERR_NOMEM;
         if (res.cache_note[0] &&
             !cs_sl_note(s, "warning: %s: level-set cache: %s", who, res.cache_note))
-            return CS_IMPORT_NOMEM;
+            return CS_ERR_NOMEM;
     }
-    return CS_IMPORT_OK;
+    return CS_OK;
 }

@@ -76,7 +76,7 @@ static int scalar_value(loader *L, int id, cs_key_type t, const cs_spath *p, voi
         *(int *)out = (int)v;
     } else
         *(bool *)out = !strcasecmp(s, "true") || !strcasecmp(s, "yes");
-    return CS_IMPORT_OK;
+    return CS_OK;
 }
 
 /* A sequence of n scalars (n < 0: any number, counted in *count) of type
@@ -95,7 +95,7 @@ static int scalars(loader *L, int id, cs_key_type t, int n, size_t size, cs_spat
     }
     char *a = calloc((size_t)have + 1, size);
     if (!a)
-        return CS_IMPORT_NOMEM;
+        return CS_ERR_NOMEM;
     *out = a;
     for (long i = 0; i < have; i++) {
         cs_spath_push_index(p, i);
@@ -106,7 +106,7 @@ static int scalars(loader *L, int id, cs_key_type t, int n, size_t size, cs_spat
     }
     if (count)
         *count = (unsigned)have;
-    return CS_IMPORT_OK;
+    return CS_OK;
 }
 
 static int section(loader *L, int sec, int id, cs_spath *p, void *raw);
@@ -119,7 +119,7 @@ static int member(loader *L, const cs_scene_key *k, int id, cs_spath *p, void *r
     const yaml_node_t *n = node(L, id);
     bool inline_value = k->required && (k->type == CS_KT_NUM || k->type == CS_KT_ENUM);
     void *v = NULL;
-    int rc = CS_IMPORT_OK;
+    int rc = CS_OK;
     switch (k->type) {
     case CS_KT_NUM:
     case CS_KT_INT:
@@ -129,7 +129,7 @@ static int member(loader *L, const cs_scene_key *k, int id, cs_spath *p, void *r
         if (inline_value)
             return scalar_value(L, id, k->type, p, m);
         if (!(v = calloc(1, size)))
-            return CS_IMPORT_NOMEM;
+            return CS_ERR_NOMEM;
         rc = scalar_value(L, id, k->type, p, v);
         break;
     }
@@ -138,7 +138,7 @@ static int member(loader *L, const cs_scene_key *k, int id, cs_spath *p, void *r
         if (!n || n->type != YAML_SCALAR_NODE)
             return fail_node(L, p);
         if (!(v = cs_sl_strdup((const char *)n->data.scalar.value)))
-            return CS_IMPORT_NOMEM;
+            return CS_ERR_NOMEM;
         break;
     case CS_KT_ENUM: {
         unsigned i = 0;
@@ -149,10 +149,10 @@ static int member(loader *L, const cs_scene_key *k, int id, cs_spath *p, void *r
             return fail_node(L, p);
         if (inline_value) {
             *(int *)m = (int)k->names[i].val;
-            return CS_IMPORT_OK;
+            return CS_OK;
         }
         if (!(v = malloc(sizeof(int))))
-            return CS_IMPORT_NOMEM;
+            return CS_ERR_NOMEM;
         *(int *)v = (int)k->names[i].val;
         break;
     }
@@ -162,10 +162,10 @@ static int member(loader *L, const cs_scene_key *k, int id, cs_spath *p, void *r
                      k->type == CS_KT_VEC ? sizeof(double) : sizeof(int), p, &v, NULL);
         break;
     case CS_KT_IDXLIST: rc = scalars(L, id, CS_KT_INT, -1, sizeof(int), p, &v, count); break;
-    case CS_KT_SCALE: return CS_IMPORT_OK; /* read from the document */
+    case CS_KT_SCALE: return CS_OK; /* read from the document */
     case CS_KT_MAP:
         if (!(v = calloc(1, cs_scene_sections[k->child].size)))
-            return CS_IMPORT_NOMEM;
+            return CS_ERR_NOMEM;
         rc = section(L, k->child, id, p, v);
         break;
     case CS_KT_LIST:
@@ -181,18 +181,18 @@ static int member(loader *L, const cs_scene_key *k, int id, cs_spath *p, void *r
                       : (size_t)k->n * (k->type == CS_KT_VLIST ? sizeof(double) : sizeof(int));
         char *a = calloc((size_t)have + 1, size);
         if (!a)
-            return CS_IMPORT_NOMEM;
+            return CS_ERR_NOMEM;
         v = a;
         *(void **)m = v;
         *count = (unsigned)have; /* what is filled is freed with it */
-        for (long i = 0; rc == CS_IMPORT_OK && i < have; i++) {
+        for (long i = 0; rc == CS_OK && i < have; i++) {
             cs_spath_push_index(p, i);
             int e = n->data.sequence.items.start[i];
             void *entry = NULL;
             if (k->type == CS_KT_LIST)
                 rc = section(L, k->child, e, p, a + (size_t)i * size);
             else if ((rc = scalars(L, e, k->type == CS_KT_VLIST ? CS_KT_NUM : CS_KT_INT, k->n,
-                                   size / (size_t)k->n, p, &entry, NULL)) == CS_IMPORT_OK)
+                                   size / (size_t)k->n, p, &entry, NULL)) == CS_OK)
                 memcpy(a + (size_t)i * size, entry, size);
             free(entry);
             p->n--;
@@ -231,7 +231,7 @@ static int section(loader *L, int sec, int id, cs_spath *p, void *raw)
         if (seen[k - cs_scene_keys]) {
             cs_sl_fail_at(L, p, false, "duplicate key");
             L->err_second = true;
-            return CS_IMPORT_BAD_INPUT;
+            return CS_ERR_BAD_INPUT;
         }
         seen[k - cs_scene_keys] = true;
         int rc = member(L, k, pair.value, p, raw);
@@ -244,7 +244,7 @@ static int section(loader *L, int sec, int id, cs_spath *p, void *raw)
             cs_spath_push_key(p, cs_scene_keys[i].key, strlen(cs_scene_keys[i].key));
             return cs_sl_fail_at(L, p, false, "required key is missing");
         }
-    return CS_IMPORT_OK;
+    return CS_OK;
 }
 
 /* Frees what raw's member k holds, and clears it. */
@@ -293,12 +293,12 @@ int cs_sl_apply_override(loader *L, cs_raw_scene *raw, const cs_spath *p)
             cs_sloc loc;
             cs_sdoc_locate(&L->doc, &at, false, &loc);
             clear(L, k, cur);
-            return loc.matched == at.n ? member(L, k, loc.node, &at, cur) : CS_IMPORT_OK;
+            return loc.matched == at.n ? member(L, k, loc.node, &at, cur) : CS_OK;
         }
         void **child = (void **)((char *)cur + k->raw);
         if (into_map) {
             if (!*child && !(*child = calloc(1, cs_scene_sections[k->child].size)))
-                return CS_IMPORT_NOMEM;
+                return CS_ERR_NOMEM;
             cur = *child;
         } else {
             long j = index_of(p, ++i); /* in range: the document has the entry */
@@ -307,7 +307,7 @@ int cs_sl_apply_override(loader *L, cs_raw_scene *raw, const cs_spath *p)
         }
         sec = k->child;
     }
-    return CS_IMPORT_OK;
+    return CS_OK;
 }
 
 /* A mapping an override made has every required key, once all are applied
@@ -321,7 +321,7 @@ int cs_sl_check_required(loader *L, int sec, const void *raw, cs_spath *p)
             continue;
         const void *v = *(const void *const *)((const char *)raw + k->raw);
         cs_spath_push_key(p, k->key, strlen(k->key));
-        int rc = CS_IMPORT_OK;
+        int rc = CS_OK;
         if (!v && k->required)
             rc = cs_sl_fail_at(L, p, false, "required key is missing");
         else if (v && k->type == CS_KT_MAP)
@@ -338,5 +338,5 @@ int cs_sl_check_required(loader *L, int sec, const void *raw, cs_spath *p)
         if (rc)
             return rc;
     }
-    return CS_IMPORT_OK;
+    return CS_OK;
 }

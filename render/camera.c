@@ -35,17 +35,17 @@ int cs_render_camera_check(const cs_render_camera *c, char *err, size_t errlen)
 {
     if (!c) {
         cs_render_error(err, errlen, "no camera given");
-        return CS_RENDER_BAD_INPUT;
+        return CS_ERR_BAD_INPUT;
     }
     if (!finite3(c->position) || !finite3(c->target) || !finite3(c->up) ||
         !isfinite(c->fov_degrees)) {
         cs_render_error(err, errlen, "the camera has a non-finite position, target, up or fov");
-        return CS_RENDER_BAD_INPUT;
+        return CS_ERR_BAD_INPUT;
     }
     if (!(c->fov_degrees > 0 && c->fov_degrees < 180)) {
         cs_render_error(err, errlen, "camera fov must be in (0, 180) degrees (got %g)",
                         c->fov_degrees);
-        return CS_RENDER_BAD_INPUT;
+        return CS_ERR_BAD_INPUT;
     }
     double f[3], s[3];
     for (int i = 0; i < 3; i++)
@@ -55,19 +55,19 @@ int cs_render_camera_check(const cs_render_camera *c, char *err, size_t errlen)
     if (!(len > 1e-12 * scale)) {
         cs_render_error(err, errlen, "the camera target is at its position (%g, %g, %g)",
                         c->position[0], c->position[1], c->position[2]);
-        return CS_RENDER_BAD_INPUT;
+        return CS_ERR_BAD_INPUT;
     }
     double up[3] = {c->up[0], c->up[1], c->up[2]};
     if (!(normalize3(up) > 0)) {
         cs_render_error(err, errlen, "the camera's up direction is zero");
-        return CS_RENDER_BAD_INPUT;
+        return CS_ERR_BAD_INPUT;
     }
     cross3(f, up, s);
     if (!(sqrt(dot3(s, s)) > 1e-6)) {
         cs_render_error(err, errlen, "the camera's up direction is along its view direction");
-        return CS_RENDER_BAD_INPUT;
+        return CS_ERR_BAD_INPUT;
     }
-    return CS_RENDER_OK;
+    return CS_OK;
 }
 
 void cs_camera_basis_make(const cs_render_camera *c, int width, int height, cs_camera_basis *b)
@@ -87,7 +87,7 @@ void cs_camera_basis_make(const cs_render_camera *c, int width, int height, cs_c
 bool cs_render_camera_project(const cs_render_camera *c, int width, int height,
                               const double p[3], double pixel[2])
 {
-    if (cs_render_camera_check(c, NULL, 0) != CS_RENDER_OK || width < 1 || height < 1)
+    if (cs_render_camera_check(c, NULL, 0) != CS_OK || width < 1 || height < 1)
         return false;
     cs_camera_basis b;
     cs_camera_basis_make(c, width, height, &b);

@@ -402,13 +402,13 @@ int cs_embree_draw(cs_embree *e, const cs_prepared_scene *ps, const cs_render_ca
         free(meshes);
         free(j);
         cs_render_error(err, errlen, "out of memory");
-        return CS_RENDER_NOMEM;
+        return CS_ERR_NOMEM;
     }
     j->scene = build_scene(e, ps, meshes, err, errlen);
     if (!j->scene) {
         free(meshes);
         free(j);
-        return CS_RENDER_FAILED;
+        return CS_ERR_FAILED;
     }
 
     cs_camera_basis b;
@@ -458,10 +458,10 @@ int cs_embree_draw(cs_embree *e, const cs_prepared_scene *ps, const cs_render_ca
     stats->rays = atomic_load(&j->rays);
     stats->covered = atomic_load(&j->covered);
     rtcReleaseScene(j->scene);
-    int rc = CS_RENDER_OK;
+    int rc = CS_OK;
     if (e->error[0]) {
         cs_render_error(err, errlen, "Embree failed while tracing: %s", e->error);
-        rc = CS_RENDER_FAILED;
+        rc = CS_ERR_FAILED;
     }
     free(meshes);
     free(j);

@@ -126,11 +126,11 @@ int cs_image_write_png(const cs_image *img, const char *path, char *err, size_t 
 {
     if (!img || !img->rgb || !path || !*path) {
         cs_render_error(err, errlen, "cs_image_write_png: no image or no file name");
-        return CS_RENDER_FAILED;
+        return CS_ERR_FAILED;
     }
     return cs_write_atomic(path, false, fill_png, (void *)img, err, errlen) == 0
-               ? CS_RENDER_OK
-               : CS_RENDER_FAILED;
+               ? CS_OK
+               : CS_ERR_FAILED;
 }
 
 cs_image *cs_image_read_png(const char *path, char *err, size_t errlen)

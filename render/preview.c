@@ -359,7 +359,7 @@ static int upload_and_draw(cs_preview *p, const cs_prepared_mesh *pm, float *scr
         glDisable(GL_POLYGON_OFFSET_LINE);
         glPolygonMode(GL_FRONT_AND_BACK, GL_FILL);
     }
-    return CS_RENDER_OK;
+    return CS_OK;
 }
 
 int cs_preview_draw(cs_preview *p, const cs_prepared_scene *ps, const cs_render_camera *camera,
@@ -368,7 +368,7 @@ int cs_preview_draw(cs_preview *p, const cs_prepared_scene *ps, const cs_render_
     int w = image->width, h = image->height;
     if (!make_current(p)) {
         cs_render_error(err, errlen, "preview: OSMesa cannot make its context current");
-        return CS_RENDER_FAILED;
+        return CS_ERR_FAILED;
     }
     int maxv = 0, maxt = 0;
     for (int m = 0; m < ps->nmeshes; m++) {
@@ -383,7 +383,7 @@ int cs_preview_draw(cs_preview *p, const cs_prepared_scene *ps, const cs_render_
         free(scratch);
         free(indices);
         cs_render_error(err, errlen, "out of memory");
-        return CS_RENDER_NOMEM;
+        return CS_ERR_NOMEM;
     }
 
     cs_camera_basis b;
@@ -449,7 +449,7 @@ int cs_preview_draw(cs_preview *p, const cs_prepared_scene *ps, const cs_render_
     GLenum e = glGetError();
     if (e != GL_NO_ERROR) {
         cs_render_error(err, errlen, "preview: GL error 0x%x while drawing", e);
-        return CS_RENDER_FAILED;
+        return CS_ERR_FAILED;
     }
 
     /* OSMesa's rows run bottom-up; the image's top-down. */
@@ -468,5 +468,5 @@ int cs_preview_draw(cs_preview *p, const cs_prepared_scene *ps, const cs_render_
     }
     stats->covered = covered;
     stats->rays = 0;
-    return CS_RENDER_OK;
+    return CS_OK;
 }

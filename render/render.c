@@ -53,29 +53,29 @@ int cs_render_settings_check(const cs_render_settings *s, char *err, size_t errl
 {
     if (s->engine != CS_RENDER_EMBREE && s->engine != CS_RENDER_PREVIEW) {
         cs_render_error(err, errlen, "unknown render engine %d", (int)s->engine);
-        return CS_RENDER_BAD_INPUT;
+        return CS_ERR_BAD_INPUT;
     }
     if (s->width < 1 || s->height < 1 || s->width > CS_RENDER_MAX_SIZE ||
         s->height > CS_RENDER_MAX_SIZE) {
         cs_render_error(err, errlen, "image size %dx%d: each side must be 1 to %d pixels",
                         s->width, s->height, CS_RENDER_MAX_SIZE);
-        return CS_RENDER_BAD_INPUT;
+        return CS_ERR_BAD_INPUT;
     }
     if (s->samples < 1 || s->samples > CS_RENDER_MAX_SAMPLES) {
         cs_render_error(err, errlen, "samples per pixel must be 1 to %d (got %d)",
                         CS_RENDER_MAX_SAMPLES, s->samples);
-        return CS_RENDER_BAD_INPUT;
+        return CS_ERR_BAD_INPUT;
     }
     if (s->bounces < 0 || s->bounces > 16) {
         cs_render_error(err, errlen, "bounces must be 0 to 16 (got %d)", s->bounces);
-        return CS_RENDER_BAD_INPUT;
+        return CS_ERR_BAD_INPUT;
     }
     if (s->threads < 0 || s->threads > 1024) {
         cs_render_error(err, errlen, "threads must be 0 (all cores) to 1024 (got %d)",
                         s->threads);
-        return CS_RENDER_BAD_INPUT;
+        return CS_ERR_BAD_INPUT;
     }
-    return CS_RENDER_OK;
+    return CS_OK;
 }
 
 cs_renderer *cs_renderer_create(const cs_render_settings *settings, char *err, size_t errlen)
@@ -84,7 +84,7 @@ cs_renderer *cs_renderer_create(const cs_render_settings *settings, char *err, s
         cs_render_error(err, errlen, "no render settings given");
         return NULL;
     }
-    if (cs_render_settings_check(settings, err, errlen) != CS_RENDER_OK)
+    if (cs_render_settings_check(settings, err, errlen) != CS_OK)
         return NULL;
     cs_renderer *r = calloc(1, sizeof *r);
     if (!r) {
@@ -129,32 +129,32 @@ static int check_mesh(const cs_render_mesh *m, int index, char *err, size_t errl
     mesh_name(m, index, name, sizeof name);
     if (m->nv < 1 || !m->x) {
         cs_render_error(err, errlen, "mesh %s has no vertices", name);
-        return CS_RENDER_BAD_INPUT;
+        return CS_ERR_BAD_INPUT;
     }
     if (m->nt < 1 || !m->tri) {
         cs_render_error(err, errlen, "mesh %s has no triangles to draw", name);
-        return CS_RENDER_BAD_INPUT;
+        return CS_ERR_BAD_INPUT;
     }
     for (int c = 0; c < 3; c++)
         if (!(m->color[c] >= 0 && m->color[c] <= 1)) {
             cs_render_error(err, errlen, "mesh %s: colour component %g is not in [0, 1]", name,
                             m->color[c]);
-            return CS_RENDER_BAD_INPUT;
+            return CS_ERR_BAD_INPUT;
         }
     for (size_t i = 0; i < 3 * (size_t)m->nv; i++)
         if (!isfinite(m->x[i])) {
             cs_render_error(err, errlen, "mesh %s: vertex %zu has a non-finite coordinate", name,
                             i / 3);
-            return CS_RENDER_BAD_INPUT;
+            return CS_ERR_BAD_INPUT;
         }
     for (size_t i = 0; i < 3 * (size_t)m->nt; i++)
         if (m->tri[i] < 0 || m->tri[i] >= m->nv) {
             cs_render_error(err, errlen,
                             "mesh %s: triangle %zu uses vertex %d of %d (out of range)", name,
                             i / 3, m->tri[i], m->nv);
-            return CS_RENDER_BAD_INPUT;
+            return CS_ERR_BAD_INPUT;
         }
-    return CS_RENDER_OK;
+    return CS_OK;
 }
 
 /* Crossings of the ray eye + t d (t > 0) with the mesh (Moeller-Trumbore in
@@ -262,22 +262,22 @@ int cs_renderer_draw(cs_renderer *r, int nmeshes, const cs_render_mesh *meshes,
     memset(stats, 0, sizeof *stats);
     if (!r || !image || !image->rgb || !image->coverage) {
         cs_render_error(err, errlen, "cs_renderer_draw: no renderer or no image");
-        return CS_RENDER_FAILED;
+        return CS_ERR_FAILED;
     }
     if (image->width != r->settings.width || image->height != r->settings.height) {
         cs_render_error(err, errlen, "image is %dx%d, the renderer draws %dx%d", image->width,
                         image->height, r->settings.width, r->settings.height);
-        return CS_RENDER_FAILED;
+        return CS_ERR_FAILED;
     }
     if (nmeshes < 1 || !meshes) {
         cs_render_error(err, errlen, "nothing to draw: no meshes given");
-        return CS_RENDER_BAD_INPUT;
+        return CS_ERR_BAD_INPUT;
     }
     int rc;
     for (int m = 0; m < nmeshes; m++)
-        if ((rc = check_mesh(&meshes[m], m, err, errlen)) != CS_RENDER_OK)
+        if ((rc = check_mesh(&meshes[m], m, err, errlen)) != CS_OK)
             return rc;
-    if ((rc = cs_render_camera_check(camera, err, errlen)) != CS_RENDER_OK)
+    if ((rc = cs_render_camera_check(camera, err, errlen)) != CS_OK)
         return rc;
     for (int m = 0; m < nmeshes; m++) {
         if (meshes[m].closed && inside_closed(&meshes[m], camera->position)) {
@@ -285,7 +285,7 @@ int cs_renderer_draw(cs_renderer *r, int nmeshes, const cs_render_mesh *meshes,
             cs_render_error(err, errlen, "the camera at (%g, %g, %g) is inside mesh %s",
                             camera->position[0], camera->position[1], camera->position[2],
                             mesh_name(&meshes[m], m, name, sizeof name));
-            return CS_RENDER_BAD_INPUT;
+            return CS_ERR_BAD_INPUT;
         }
     }
 
@@ -295,7 +295,7 @@ int cs_renderer_draw(cs_renderer *r, int nmeshes, const cs_render_mesh *meshes,
     p.meshes = calloc((size_t)nmeshes, sizeof *p.meshes);
     if (!p.meshes) {
         cs_render_error(err, errlen, "out of memory");
-        return CS_RENDER_NOMEM;
+        return CS_ERR_NOMEM;
     }
     for (int i = 0; i < 3; i++) {
         p.lo[i] = INFINITY;
@@ -309,7 +309,7 @@ int cs_renderer_draw(cs_renderer *r, int nmeshes, const cs_render_mesh *meshes,
             free_prepared(&p);
             cs_render_error(err, errlen, "out of memory for the normals of %d vertices",
                             mesh->nv);
-            return CS_RENDER_NOMEM;
+            return CS_ERR_NOMEM;
         }
         vertex_normals(mesh, p.meshes[m].normals);
         for (int v = 0; v < mesh->nv; v++)
@@ -325,13 +325,13 @@ int cs_renderer_draw(cs_renderer *r, int nmeshes, const cs_render_mesh *meshes,
         rc = cs_preview_draw(r->preview, &p, camera, image, stats, err, errlen);
     free_prepared(&p);
     stats->seconds = cs_now() - t0;
-    if (rc == CS_RENDER_OK && stats->covered == 0) {
+    if (rc == CS_OK && stats->covered == 0) {
         cs_render_error(err, errlen,
                         "the camera sees nothing: no mesh is in its view (camera at (%g, %g, "
                         "%g) looking at (%g, %g, %g))",
                         camera->position[0], camera->position[1], camera->position[2],
                         camera->target[0], camera->target[1], camera->target[2]);
-        return CS_RENDER_BAD_INPUT;
+        return CS_ERR_BAD_INPUT;
     }
     return rc;
 }
@@ -342,24 +342,24 @@ int cs_render_png(const char *path, int nmeshes, const cs_render_mesh *meshes,
 {
     if (!settings) {
         cs_render_error(err, errlen, "no render settings given");
-        return CS_RENDER_FAILED;
+        return CS_ERR_FAILED;
     }
     int rc = cs_render_settings_check(settings, err, errlen);
-    if (rc != CS_RENDER_OK)
+    if (rc != CS_OK)
         return rc;
     cs_image *img = cs_image_create(settings->width, settings->height);
     if (!img) {
         cs_render_error(err, errlen, "out of memory for a %dx%d image", settings->width,
                         settings->height);
-        return CS_RENDER_NOMEM;
+        return CS_ERR_NOMEM;
     }
     cs_renderer *r = cs_renderer_create(settings, err, errlen);
     if (!r) {
         cs_image_destroy(img);
-        return CS_RENDER_FAILED;
+        return CS_ERR_FAILED;
     }
     rc = cs_renderer_draw(r, nmeshes, meshes, camera, img, NULL, err, errlen);
-    if (rc == CS_RENDER_OK)
+    if (rc == CS_OK)
         rc = cs_image_write_png(img, path, err, errlen);
     cs_renderer_destroy(r);
     cs_image_destroy(img);

@@ -25,20 +25,16 @@
 #include <stdbool.h>
 #include <stddef.h>
 
+#include "common/error.h"
+
 #ifdef __cplusplus
 extern "C" {
 #endif
 
-/* Status codes; CS_RENDER_BAD_INPUT (an invalid size, mesh or camera, or a
- * camera that sees nothing) is the command's exit status 2. */
-enum {
-    CS_RENDER_OK = 0,
-    CS_RENDER_BAD_INPUT = -20,
-    CS_RENDER_NOMEM = -21,
-    CS_RENDER_FAILED = -22,   /* an engine or a file failed */
-};
+/* Statuses (common/error.h): CS_ERR_BAD_INPUT (an invalid size, mesh or
+ * camera, or a camera that sees nothing) is the command's exit status 2;
+ * CS_ERR_NOMEM; CS_ERR_FAILED (an engine or a file failed). */
 
-/* Largest image side and sample count accepted. */
 #define CS_RENDER_MAX_SIZE 16384
 #define CS_RENDER_MAX_SAMPLES 4096
 
@@ -66,7 +62,7 @@ typedef struct cs_render_camera {
     double fov_degrees;     /* vertical field of view, in (0, 180) */
 } cs_render_camera;
 
-/* CS_RENDER_OK, or CS_RENDER_BAD_INPUT with one line in err saying what is
+/* CS_OK, or CS_ERR_BAD_INPUT with one line in err saying what is
  * wrong (a non-finite value, target at the position, up along the view,
  * fov out of range). */
 int cs_render_camera_check(const cs_render_camera *camera, char *err, size_t errlen);
@@ -120,7 +116,7 @@ typedef struct cs_render_settings {
 /* embree, 640 x 480, 16 samples, 2 bounces, all cores, smooth, no wireframe. */
 cs_render_settings cs_render_default_settings(void);
 
-/* CS_RENDER_OK, or CS_RENDER_BAD_INPUT with one line in err. */
+/* CS_OK, or CS_ERR_BAD_INPUT with one line in err. */
 int cs_render_settings_check(const cs_render_settings *settings, char *err, size_t errlen);
 
 /* ------------------------------------------------------------------ images */
@@ -192,7 +188,7 @@ int cs_render_contact_sheet(const char *path, int nimages, const cs_image *const
  * (palettegen/paletteuse) when path ends in .gif, else an MP4 (H.264,
  * yuv420p, sides padded to even). Written atomically (path.tmp, renamed);
  * ffmpeg's own messages go to stderr. Returns 1 made, 0 skipped (no ffmpeg
- * on the PATH), or CS_RENDER_FAILED with err (ffmpeg failed, or could not
+ * on the PATH), or CS_ERR_FAILED with err (ffmpeg failed, or could not
  * be started; nothing is left under path). */
 int cs_render_animation(const char *pattern, int first, int count, double fps,
                         const char *path, char *err, size_t errlen);

@@ -53,13 +53,13 @@ int cs_render_contact_sheet(const char *path, int nimages, const cs_image *const
     if (nimages < 1 || !images || !images[0] || columns < 1 || thumb_width < 1 ||
         thumb_width > CS_RENDER_MAX_SIZE) {
         cs_render_error(err, errlen, "contact sheet: nothing to compose");
-        return CS_RENDER_BAD_INPUT;
+        return CS_ERR_BAD_INPUT;
     }
     int w = images[0]->width, h = images[0]->height;
     for (int i = 1; i < nimages; i++)
         if (!images[i] || images[i]->width != w || images[i]->height != h) {
             cs_render_error(err, errlen, "contact sheet: the images differ in size");
-            return CS_RENDER_BAD_INPUT;
+            return CS_ERR_BAD_INPUT;
         }
     if (columns > nimages)
         columns = nimages;
@@ -72,7 +72,7 @@ int cs_render_contact_sheet(const char *path, int nimages, const cs_image *const
     if (sheet_w > 32767 || sheet_h > 32767) {
         cs_render_error(err, errlen, "contact sheet: %dx%d pixels is too large", sheet_w,
                         sheet_h);
-        return CS_RENDER_BAD_INPUT;
+        return CS_ERR_BAD_INPUT;
     }
 
     cairo_surface_t *sheet = cairo_image_surface_create(CAIRO_FORMAT_RGB24, sheet_w, sheet_h);
@@ -103,12 +103,12 @@ int cs_render_contact_sheet(const char *path, int nimages, const cs_image *const
     }
     cairo_status_t st = cairo_status(cr);
     cairo_destroy(cr);
-    int rc = CS_RENDER_OK;
+    int rc = CS_OK;
     if (st != CAIRO_STATUS_SUCCESS) {
         cs_render_error(err, errlen, "contact sheet: cairo: %s", cairo_status_to_string(st));
-        rc = CS_RENDER_FAILED;
+        rc = CS_ERR_FAILED;
     } else if (cs_write_atomic(path, false, fill_sheet, sheet, err, errlen) != 0) {
-        rc = CS_RENDER_FAILED;
+        rc = CS_ERR_FAILED;
     }
     cairo_surface_destroy(sheet);
     return rc;
@@ -194,7 +194,7 @@ int cs_render_animation(const char *pattern, int first, int count, double fps,
         return 0;
     if (first < 0 || count < 1) {
         cs_render_error(err, errlen, "animation %s: no frames", path);
-        return CS_RENDER_BAD_INPUT;
+        return CS_ERR_BAD_INPUT;
     }
     char rate[32], first_s[16], count_s[16];
     snprintf(rate, sizeof rate, "%.17g", fps > 0 ? fps : 12.0);
@@ -204,6 +204,6 @@ int cs_render_animation(const char *pattern, int first, int count, double fps,
     animation_job a = {ffmpeg, pattern, rate, first_s, count_s,
                        len >= 4 && strcmp(path + len - 4, ".gif") == 0};
     if (cs_write_atomic(path, false, fill_animation, &a, err, errlen) != 0)
-        return CS_RENDER_FAILED;
+        return CS_ERR_FAILED;
     return 1;
 }

@@ -3,7 +3,7 @@
  * through cs_body_def.phi_fn with the same interface. */
 #include <string.h>
 
-#include "sim/sim.h"
+#include "sim/internal.h"
 #include "sim/vec3.h"
 
 cs_body_def cs_default_body_def(void)

@@ -10,6 +10,19 @@
 #include "sim/springs.h"
 #include "sim/vec3.h"
 
+/* body.c: a body posed once for many queries */
+/* A body's frame at one time: for many queries at that time (a step asks
+ * each body about every point near it), computed once. */
+typedef struct cs_body_pose {
+    double R[9], c[3], velocity[3], omega[3];
+    bool unrotated; /* R is exactly the identity: queries skip the products */
+} cs_body_pose;
+void cs_body_def_pose(const cs_body_def *b, double t, cs_body_pose *pose);
+/* cs_body_def_phi and cs_body_def_velocity at a pose: the same numbers */
+double cs_body_posed_phi(const cs_body_def *b, const cs_body_pose *pose, const double x[3],
+                         double grad[3]);
+void cs_body_posed_velocity(const cs_body_pose *pose, const double x[3], double v[3]);
+
 /* What the solver may change about a particle's velocity. */
 enum { CS_FIXED = 0, CS_FREE = 1, CS_CONTACT = 2 };
 
@@ -25,7 +38,7 @@ typedef struct cs_script_state {
 } cs_script_state;
 
 /* A script that step C held back runs at this multiple of its speed until
- * its clock is the simulation's again (step.c; runaway.c bounds it). */
+ * its clock is the simulation's again (scripts.c; runaway.c bounds it). */
 static const double CS_SCRIPT_CATCH_UP_RATE = 2.0;
 
 /* runaway.c: what instability detection knows (see there). */
@@ -79,7 +92,7 @@ struct cs_sim {
     /* per script: how far (s) its clock is behind the simulation's, after
      * step C held it back (selfcol_collide.c), and the same at the outer
      * step's start; a script behind runs at twice the speed until it is
-     * back on time (step.c's script_targets) */
+     * back on time (scripts.c's cs_script_targets) */
     double *script_lag, *script_lag_start;
     int nbodies;
     cs_body_def *bodies;          /* motion keys owned by the sim */
@@ -192,11 +205,21 @@ int cs_runaway_not_finite(cs_sim *sim, const double *v_next);
  * current positions
  * (collective: every rank calls it at the same point). */
 void cs_step_limit_init(cs_sim *sim);
-
-/* step.c: the vertices of scripts with a release time still to come are
- * held (hold) or, while the step limit is computed for the whole run, free */
-void cs_scripts_hold_releasable(cs_sim *sim, bool hold);
 double cs_step_limit_now(cs_sim *sim);
+
+/* scripts.c: the targets of scripted vertices at the end t1 of a step of
+ * dt (script_x, script_v), at each script's own time t1 - lag */
+void cs_script_targets(cs_sim *sim, double t1, double dt);
+/* scripts whose release time has come let their vertices go, at the start
+ * of a step */
+void cs_scripts_release(cs_sim *sim, double dt);
+/* the vertices of scripts with a release time still to come are held
+ * (hold) or, while the step limit is computed for the whole run, free */
+void cs_scripts_hold_releasable(cs_sim *sim, bool hold);
+
+/* wind.c: area-weighted vertex normals and a third of the adjacent area
+ * at positions x (wind_normal, wind_area), for the drag */
+void cs_wind_geometry(cs_sim *sim, const double *x);
 
 /* contact.c: Section 6. */
 void cs_gamma(const double v[3], const double N[3], const double vb[3], double mu,

@@ -469,7 +469,7 @@ static void note_conflict(cs_sim *sim, const int *list, int count)
  * that holds vertices of two prescribed motions, which no rigid motion
  * follows, by the projection of selfcol_project.c (script_zones: follow),
  * or held where it was collision free with its scripts (hold_script: they
- * wait, then catch up in step.c's script_targets). Returns false when a
+ * wait, then catch up in scripts.c's cs_script_targets). Returns false when a
  * zone has no answer that follows its scripts (sc->conflict says which). */
 static bool move_zones(cs_sim *sim, double span, double *dv)
 {

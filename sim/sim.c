@@ -1,5 +1,5 @@
 /* sim.c: the definitions' defaults, creating and destroying the
- * simulation, and its accessors. The step is in step.c. */
+ * simulation, and its accessors. The step is in step.c, frames in frame.c. */
 #include <math.h>
 #include <stdarg.h>
 #include <stdio.h>

@@ -13,6 +13,8 @@
 #include <stdbool.h>
 #include <stddef.h>
 
+#include "common/error.h"
+
 #ifdef __cplusplus
 extern "C" {
 #endif
@@ -29,16 +31,9 @@ typedef int cs_comm;
 
 /* ---------------------------------------------------------------- status */
 
-/* Every fallible call returns CS_OK or a negative code and, where a message
- * buffer is given, a sentence that says what was wrong. */
-enum {
-    CS_OK = 0,
-    CS_ERR_INVALID = -1,   /* a definition that makes no sense */
-    CS_ERR_NOMEM = -2,
-    CS_ERR_UNSTABLE = -3,  /* NaN or runaway velocity detected */
-    CS_ERR_SCRIPT = -4,    /* step C found no collision-free state that
-                              follows the scripts (cs_sim_script_conflict) */
-};
+/* Every fallible call returns CS_OK or a negative cs_status (CS_ERR_INVALID,
+ * CS_ERR_NOMEM, CS_ERR_UNSTABLE, CS_ERR_SCRIPT) and, where a message buffer
+ * is given, a sentence that says what was wrong. */
 
 /* -------------------------------------------------------------- geometry */
 
@@ -169,18 +164,6 @@ cs_body_def cs_default_body_def(void);
 
 /* Signed distance and unit gradient of a body at world point x, time t. */
 double cs_body_def_phi(const cs_body_def *b, double t, const double x[3], double grad[3]);
-
-/* A body's frame at one time: for many queries at that time (a step asks
- * each body about every point near it), computed once. */
-typedef struct cs_body_pose {
-    double R[9], c[3], velocity[3], omega[3];
-    bool unrotated; /* R is exactly the identity: queries skip the products */
-} cs_body_pose;
-void cs_body_def_pose(const cs_body_def *b, double t, cs_body_pose *pose);
-/* cs_body_def_phi and cs_body_def_velocity at a pose: the same numbers */
-double cs_body_posed_phi(const cs_body_def *b, const cs_body_pose *pose, const double x[3],
-                         double grad[3]);
-void cs_body_posed_velocity(const cs_body_pose *pose, const double x[3], double v[3]);
 
 /* The body's Coulomb coefficient at time t: `friction`, or its schedule
  * evaluated at t (see cs_body_def.friction_keys). */
@@ -355,8 +338,11 @@ cs_sim_def cs_default_sim_def(void);
 
 /* ------------------------------------------------------- plan and timing */
 
-/* The stages a step can contain, in the order they run. A plan holds only
- * the ones the scene calls for; the others are neither run nor allocated. */
+/* The stages of a time step, of an outer collision step and of a frame.
+ * The values name them (and index timing arrays and stored totals); the
+ * order they run in is the stage table's (sim/stages.c), cs_stage_in_order.
+ * A plan holds only the ones the scene calls for; the others are neither
+ * run nor allocated. */
 typedef enum cs_stage {
     CS_STAGE_REPULSION_PAIRS = 0,   /* A: repulsion pairs and their history */
     CS_STAGE_SCRIPTED_VERTICES,     /* prescribed positions and velocities */
@@ -374,19 +360,28 @@ typedef enum cs_stage {
     CS_STAGE_COUNT
 } cs_stage;
 
+/* The i-th stage of the table, 0 <= i < CS_STAGE_COUNT, in the order the
+ * stages run (CS_STAGE_COUNT outside that range). */
+cs_stage cs_stage_in_order(int i);
 const char *cs_stage_name(cs_stage stage);
+const char *cs_stage_description(cs_stage stage);
+/* What a scene needs for the stage to be in its plan ("always",
+ * "effects.self_collision", ...). */
+const char *cs_stage_condition(cs_stage stage);
+/* When the stage runs ("each time step", ...). */
+const char *cs_stage_when(cs_stage stage);
 /* The memory a run of this many particles will need at its peak, bytes (an
  * estimate from measurements, with a margin), so that a scene too large
  * for the machine is refused before anything is allocated. */
 double cs_sim_estimate_bytes(double particles, bool self_collision);
-const char *cs_stage_description(cs_stage stage);
 
 typedef struct cs_plan {
     int nstages;
     cs_stage stages[CS_STAGE_COUNT];
 } cs_plan;
 
-/* What the scene definition calls for, without creating anything. */
+/* What the scene definition calls for, without creating anything: its
+ * stages in the order they run. */
 cs_plan cs_plan_from_def(const cs_sim_def *def);
 bool cs_plan_has(const cs_plan *plan, cs_stage stage);
 

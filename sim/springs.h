@@ -137,6 +137,8 @@ void cs_springs_add_damping(const cs_springs *s, const double *v, double *out);
 /* Keeps only the springs with an end owned by rank (Section 7: a spring
  * across ranks is computed by both owners, redundantly). */
 void cs_springs_keep_touching(cs_springs *s, const int *owner, int rank);
+
+/* spring_bounds.c: what limits the step (step_limit.c). */
 /* Largest eigenvalue bound (Gershgorin) of M^-1 K_elastic over particles
  * with is_free[i] set: per particle 2 * sum(E/L0) / m. */
 double cs_springs_stiffness_bound(const cs_springs *s, const double *mass,

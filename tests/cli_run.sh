@@ -129,6 +129,32 @@ sys.exit(0 if all(p in out for p in plan) else "plan output lacks stages")
 run 0 run tiny.yaml --plan --set effects.self_collision=true --set self_collision.pruning=path
 grep -q 'self_collision.pruning path' out.txt || fail "--plan does not say step A prunes by path"
 
+# --- the stages --plan numbers are the summary's stage table, in order,
+# and each ran; the rows it leaves out never ran (self-collision off, on)
+for self in false true; do
+    run 0 run tiny.yaml --plan --set effects.self_collision=$self
+    cp out.txt plan_$self.txt
+    run 0 run tiny.yaml -q -o staged_$self --frames 1 --set effects.self_collision=$self
+    python3 - plan_$self.txt staged_$self/summary.json <<'EOF' || fail "--plan is not what ran (self_collision $self)"
+import json, re, sys
+text = open(sys.argv[1]).read()
+planned = re.findall(r"^ +\d+\. (\S+)", text, re.M)
+left_out = re.findall(r"^ +- +(\S+) +left out", text, re.M)
+s = json.load(open(sys.argv[2]))
+ran = [st["name"] for st in s["stages"]]
+if planned != s["plan"] or planned != ran:
+    sys.exit("--plan %s, summary plan %s, stages %s" % (planned, s["plan"], ran))
+idle = [st["name"] for st in s["stages"] if st["calls"] < 1]
+if idle:
+    sys.exit("planned stages that never ran: %s" % idle)
+if set(left_out) & set(ran) or len(planned) + len(left_out) != 13:
+    sys.exit("left out %s against ran %s" % (left_out, ran))
+EOF
+done
+grep -q 'collisions  *C:' plan_true.txt || fail "--plan with self-collision lacks step C"
+grep -q 'collisions  *left out: needs effects.self_collision' plan_false.txt ||
+    fail "--plan does not say what step C needs"
+
 # --- overrides: --set time.frames=1, --frames 2; a rerun replaces old frames
 run 0 run tiny.yaml -q -o one --set time.frames=1
 check_files one ply 1

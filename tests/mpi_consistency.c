@@ -68,7 +68,7 @@ static cs_scene *load(const char *name, int noverrides, const char *const *overr
     char path[1024], err[1024];
     snprintf(path, sizeof path, "%s/scenes/%s", CS_SOURCE_DIR, name);
     cs_scene *scene = NULL;
-    if (cs_scene_load(path, noverrides, overrides, &scene, err, sizeof err) != CS_IMPORT_OK) {
+    if (cs_scene_load(path, noverrides, overrides, &scene, err, sizeof err) != CS_OK) {
         fprintf(stderr, "rank %d: cannot load %s: %s\n", world_rank, path, err);
         MPI_Abort(MPI_COMM_WORLD, 2);
     }

@@ -15,9 +15,9 @@ static inline cs_scene *load_ok(const char *text, int nov, const char *const *ov
     char err[1024] = "";
     cs_scene *s = NULL;
     int rc = cs_scene_load_string(text, "scenes/a.yaml", nov, ov, &s, err, sizeof err);
-    if (rc != CS_IMPORT_OK)
+    if (rc != CS_OK)
         print_error("unexpected error: %s\n", err);
-    assert_int_equal(rc, CS_IMPORT_OK);
+    assert_int_equal(rc, CS_OK);
     assert_non_null(s);
     return s;
 }
@@ -29,9 +29,9 @@ static inline void expect_error(const char *text, int nov, const char *const *ov
     char err[1024] = "";
     cs_scene *s = (cs_scene *)&err; /* must be reset to NULL */
     int rc = cs_scene_load_string(text, "scenes/a.yaml", nov, ov, &s, err, sizeof err);
-    if (rc != CS_IMPORT_BAD_INPUT || strcmp(err, want) != 0)
+    if (rc != CS_ERR_BAD_INPUT || strcmp(err, want) != 0)
         print_error("got:  %s\nwant: %s\n", err, want);
-    assert_int_equal(rc, CS_IMPORT_BAD_INPUT);
+    assert_int_equal(rc, CS_ERR_BAD_INPUT);
     assert_null(s);
     assert_null(strchr(err, '\n'));
     assert_string_equal(err, want);

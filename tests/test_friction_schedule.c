@@ -120,7 +120,7 @@ static cs_scene *load(const char *text)
     char err[512] = "";
     cs_scene *s = NULL;
     if (cs_scene_load_string(text, "friction.yaml", 0, NULL, &s, err, sizeof err) !=
-        CS_IMPORT_OK)
+        CS_OK)
         fail_msg("%s", err);
     return s;
 }

@@ -93,12 +93,12 @@ static void scenes_end_cleanly(void **state)
         char err[1024] = "";
         cs_scene *s = NULL;
         int rc = cs_scene_load(files[i], nov, ovp, &s, err, sizeof err);
-        print_message("%s: %s\n", files[i], rc == CS_IMPORT_OK ? "loaded" : err);
-        if (rc == CS_IMPORT_OK) {
+        print_message("%s: %s\n", files[i], rc == CS_OK ? "loaded" : err);
+        if (rc == CS_OK) {
             assert_non_null(s);
         } else {
             assert_null(s);
-            assert_true(rc == CS_IMPORT_BAD_INPUT || rc == CS_IMPORT_NOMEM);
+            assert_true(rc == CS_ERR_BAD_INPUT || rc == CS_ERR_NOMEM);
             assert_true(err[0] != '\0');
         }
         cs_scene_destroy(s);
@@ -122,8 +122,8 @@ static void meshes_end_cleanly(void **state)
         cs_trimesh *m = NULL;
         cs_mesh_report r;
         int rc = cs_mesh_import(files[i], NULL, &m, &r, err, sizeof err);
-        print_message("%s: import: %s\n", files[i], rc == CS_IMPORT_OK ? "read" : err);
-        if (rc == CS_IMPORT_OK) {
+        print_message("%s: import: %s\n", files[i], rc == CS_OK ? "read" : err);
+        if (rc == CS_OK) {
             assert_non_null(m);
         } else {
             assert_null(m);
@@ -140,8 +140,8 @@ static void meshes_end_cleanly(void **state)
         err[0] = '\0';
         cs_mesh_catalog *c = NULL;
         rc = cs_mesh_catalog_read(files[i], &c, err, sizeof err);
-        print_message("%s: catalog: %s\n", files[i], rc == CS_IMPORT_OK ? "read" : err);
-        assert_true(rc == CS_IMPORT_OK ? c != NULL : c == NULL && err[0] != '\0');
+        print_message("%s: catalog: %s\n", files[i], rc == CS_OK ? "read" : err);
+        assert_true(rc == CS_OK ? c != NULL : c == NULL && err[0] != '\0');
         cs_mesh_catalog_destroy(c);
     }
     free_list(files, n);

@@ -50,9 +50,9 @@ static cs_trimesh *load(const char *name, cs_mesh_report *rep)
     require_asset(path);
     cs_trimesh *m = NULL;
     int rc = cs_mesh_import(path, NULL, &m, rep, err, sizeof err);
-    if (rc != CS_IMPORT_OK)
+    if (rc != CS_OK)
         print_error("%s\n", err);
-    assert_int_equal(rc, CS_IMPORT_OK);
+    assert_int_equal(rc, CS_OK);
     return m;
 }
 
@@ -346,7 +346,7 @@ static void test_particle_on_imported_sphere(void **state)
     pl.translate[1] = -0.180;
     pl.translate[2] = -0.898;
     cs_trimesh *m = NULL;
-    assert_int_equal(cs_mesh_import(path, &pl, &m, &rep, err, sizeof err), CS_IMPORT_OK);
+    assert_int_equal(cs_mesh_import(path, &pl, &m, &rep, err, sizeof err), CS_OK);
     const double voxel = 0.04;
     cs_levelset *ls = cs_levelset_create(m, voxel, 3, true, err, sizeof err);
     assert_non_null(ls);
@@ -406,7 +406,7 @@ static void test_moving_grid_body(void **state)
     pl.translate[2] = -0.898;
     cs_trimesh *m = NULL;
     cs_mesh_report rep;
-    assert_int_equal(cs_mesh_import(path, &pl, &m, &rep, err, sizeof err), CS_IMPORT_OK);
+    assert_int_equal(cs_mesh_import(path, &pl, &m, &rep, err, sizeof err), CS_OK);
     const double voxel = 0.05;
     cs_levelset *ls = cs_levelset_create(m, voxel, 3, true, err, sizeof err);
     assert_non_null(ls);
@@ -477,7 +477,7 @@ static void test_cache(void **state)
     cs_levelset_request req = {.voxel_size = 0.1, .band = 3, .fill_interior = true,
                                .cache_dir = dir, .label = "ico4"};
     cs_levelset_result r1, r2, r3, r4;
-    assert_int_equal(cs_levelset_build(m, &req, &r1, err, sizeof err), CS_IMPORT_OK);
+    assert_int_equal(cs_levelset_build(m, &req, &r1, err, sizeof err), CS_OK);
     assert_false(r1.from_cache);
     assert_string_equal(r1.cache_note, "");
     assert_int_equal(strncmp(r1.cache_path, dir, strlen(dir)), 0);
@@ -494,7 +494,7 @@ static void test_cache(void **state)
     snprintf(old, sizeof old, "%s/ico4-%.16s.vdb", dir, "9f86d081884c7d65");
     assert_int_equal(rename(r1.cache_path, old), 0);
     cs_levelset_result r0;
-    assert_int_equal(cs_levelset_build(m, &req, &r0, err, sizeof err), CS_IMPORT_OK);
+    assert_int_equal(cs_levelset_build(m, &req, &r0, err, sizeof err), CS_OK);
     assert_false(r0.from_cache);
     assert_string_equal(r0.cache_note, "");
     assert_string_equal(r0.cache_path, r1.cache_path);
@@ -502,7 +502,7 @@ static void test_cache(void **state)
     unlink(old);
 
     /* the same input: read back, equal values */
-    assert_int_equal(cs_levelset_build(m, &req, &r2, err, sizeof err), CS_IMPORT_OK);
+    assert_int_equal(cs_levelset_build(m, &req, &r2, err, sizeof err), CS_OK);
     assert_true(r2.from_cache);
     assert_string_equal(r1.cache_path, r2.cache_path);
     for (int i = 0; i < 50; i++) {
@@ -513,12 +513,12 @@ static void test_cache(void **state)
     /* a file's time means nothing: touching it changes nothing, and a
      * different mesh (moved by 1 mm) or voxel size is another file */
     m->x[0] += 1e-3;
-    assert_int_equal(cs_levelset_build(m, &req, &r3, err, sizeof err), CS_IMPORT_OK);
+    assert_int_equal(cs_levelset_build(m, &req, &r3, err, sizeof err), CS_OK);
     assert_false(r3.from_cache);
     assert_string_not_equal(r3.cache_path, r1.cache_path);
     m->x[0] -= 1e-3;
     req.voxel_size = 0.11;
-    assert_int_equal(cs_levelset_build(m, &req, &r4, err, sizeof err), CS_IMPORT_OK);
+    assert_int_equal(cs_levelset_build(m, &req, &r4, err, sizeof err), CS_OK);
     assert_false(r4.from_cache);
     assert_string_not_equal(r4.cache_path, r1.cache_path);
 
@@ -526,7 +526,7 @@ static void test_cache(void **state)
     cs_levelset_destroy(r2.grid);
     rename(r3.cache_path, r1.cache_path);
     req.voxel_size = 0.1;
-    assert_int_equal(cs_levelset_build(m, &req, &r2, err, sizeof err), CS_IMPORT_OK);
+    assert_int_equal(cs_levelset_build(m, &req, &r2, err, sizeof err), CS_OK);
     assert_false(r2.from_cache);
     assert_non_null(strstr(r2.cache_note, "other input"));
 
@@ -540,7 +540,7 @@ static void test_cache(void **state)
     /* an unwritable cache is a note, not a failure */
     req.cache_dir = "/proc/no/such/dir";
     cs_levelset_destroy(r2.grid);
-    assert_int_equal(cs_levelset_build(m, &req, &r2, err, sizeof err), CS_IMPORT_OK);
+    assert_int_equal(cs_levelset_build(m, &req, &r2, err, sizeof err), CS_OK);
     assert_non_null(r2.grid);
     assert_non_null(strstr(r2.cache_note, "not kept"));
 

@@ -50,7 +50,7 @@ static int answers(void *ctx, cs_bytes *out, char *err, size_t errlen)
     (void)err;
     (void)errlen;
     cs_bytes_put_str(out, ctx);
-    return CS_IMPORT_OK;
+    return CS_OK;
 }
 
 static int refuses(void *ctx, cs_bytes *out, char *err, size_t errlen)
@@ -58,7 +58,7 @@ static int refuses(void *ctx, cs_bytes *out, char *err, size_t errlen)
     (void)ctx;
     cs_bytes_put_str(out, "report");
     snprintf(err, errlen, "the file is bad");
-    return CS_IMPORT_BAD_INPUT;
+    return CS_ERR_BAD_INPUT;
 }
 
 /* What a stand-in reader does wrong. */
@@ -90,7 +90,7 @@ static int misbehaves(void *ctx, cs_bytes *out, char *err, size_t errlen)
             char *p = malloc(64 << 20);
             if (!p) {
                 snprintf(err, errlen, "out of memory");
-                return CS_IMPORT_NOMEM;
+                return CS_ERR_NOMEM;
             }
             memset(p, 1, 64 << 20);
         }
@@ -98,7 +98,7 @@ static int misbehaves(void *ctx, cs_bytes *out, char *err, size_t errlen)
     case VANISH:
         _exit(7);
     }
-    return CS_IMPORT_OK;
+    return CS_OK;
 }
 
 static void expect_failure(misdeed what, const char *want, double max_seconds)
@@ -110,7 +110,7 @@ static void expect_failure(misdeed what, const char *want, double max_seconds)
     double took = now() - t0;
     cs_bytes_free(&res);
     print_message("%.2f s: %s\n", took, err);
-    assert_int_equal(rc, CS_IMPORT_BAD_INPUT);
+    assert_int_equal(rc, CS_ERR_BAD_INPUT);
     assert_non_null(strstr(err, path));
     if (!strstr(err, want))
         fail_msg("'%s' lacks '%s'", err, want);
@@ -122,7 +122,7 @@ static void test_answer_comes_back(void **state)
     (void)state;
     char err[256] = "";
     cs_bytes res;
-    assert_int_equal(cs_guard_run(path, answers, "a mesh", &res, err, sizeof err), CS_IMPORT_OK);
+    assert_int_equal(cs_guard_run(path, answers, "a mesh", &res, err, sizeof err), CS_OK);
     cs_bytes_reader r = {res.data, res.len, false};
     char got[32];
     cs_bytes_get_str(&r, got, sizeof got);
@@ -132,7 +132,7 @@ static void test_answer_comes_back(void **state)
 
     /* a refusal brings its sentence and what was written (a report) */
     assert_int_equal(cs_guard_run(path, refuses, NULL, &res, err, sizeof err),
-                     CS_IMPORT_BAD_INPUT);
+                     CS_ERR_BAD_INPUT);
     assert_string_equal(err, "the file is bad");
     r = (cs_bytes_reader){res.data, res.len, false};
     cs_bytes_get_str(&r, got, sizeof got);
@@ -173,7 +173,7 @@ static int stuck_once(void *ctx, cs_bytes *out, char *err, size_t errlen)
             pause();
     }
     cs_bytes_put_str(out, "read");
-    return CS_IMPORT_OK;
+    return CS_OK;
 }
 
 static void test_stuck_child_starts_again(void **state)
@@ -188,7 +188,7 @@ static void test_stuck_child_starts_again(void **state)
     cs_bytes res;
     double t0 = now();
     assert_int_equal(cs_guard_run(path, stuck_once, marker, &res, err, sizeof err),
-                     CS_IMPORT_OK);
+                     CS_OK);
     double took = now() - t0;
     cs_bytes_reader r = {res.data, res.len, false};
     char got[32];

@@ -42,9 +42,9 @@ static cs_trimesh *import_ok(const char *name, const cs_mesh_placement *pl, cs_m
     asset(path, sizeof path, name);
     cs_trimesh *m = NULL;
     int rc = cs_mesh_import(path, pl, &m, r, err, sizeof err);
-    if (rc != CS_IMPORT_OK)
+    if (rc != CS_OK)
         print_error("%s\n", err);
-    assert_int_equal(rc, CS_IMPORT_OK);
+    assert_int_equal(rc, CS_OK);
     assert_non_null(m);
     assert_int_equal(m->nv, r->vertices);
     assert_int_equal(m->nt, r->triangles);
@@ -113,9 +113,9 @@ static void test_ply_ascii_and_binary(void **state)
         cs_mesh_format fmt;
         assert_true(cs_mesh_format_from_name(formats[f], &fmt));
         cs_mesh_view view = {"wuson", m->nv, m->x, m->nt, m->tri};
-        assert_int_equal(cs_mesh_write(path, fmt, 1, &view, err, sizeof err), CS_IMPORT_OK);
+        assert_int_equal(cs_mesh_write(path, fmt, 1, &view, err, sizeof err), CS_OK);
         cs_trimesh *back = NULL;
-        assert_int_equal(cs_mesh_import(path, NULL, &back, &r2, err, sizeof err), CS_IMPORT_OK);
+        assert_int_equal(cs_mesh_import(path, NULL, &back, &r2, err, sizeof err), CS_OK);
         assert_int_equal(r2.triangles, r.triangles);
         assert_int_equal(r2.vertices, r.vertices);
         assert_int_equal(r2.boundary_edges, r.boundary_edges);
@@ -239,7 +239,7 @@ static void test_collada_nodes(void **state)
     char path[1024], err[512];
     asset(path, sizeof path, "human.dae");
     cs_mesh_catalog *c = NULL;
-    assert_int_equal(cs_mesh_catalog_read(path, &c, err, sizeof err), CS_IMPORT_OK);
+    assert_int_equal(cs_mesh_catalog_read(path, &c, err, sizeof err), CS_OK);
     assert_int_equal(c->nmeshes, 2);
     assert_int_equal(c->nnodes, 3);
     assert_string_equal(c->nodes[1].name, "human-baseObject");
@@ -295,7 +295,7 @@ static void test_repairs(void **state)
                path, sizeof path);
     cs_trimesh *m = NULL;
     cs_mesh_report r;
-    assert_int_equal(cs_mesh_import(path, NULL, &m, &r, err, sizeof err), CS_IMPORT_OK);
+    assert_int_equal(cs_mesh_import(path, NULL, &m, &r, err, sizeof err), CS_OK);
     assert_int_equal(r.triangles_read, 5);
     assert_int_equal(r.duplicate_triangles, 2);     /* "3 2 1" and "1 6 3" */
     assert_int_equal(r.degenerate_triangles, 1);    /* "1 2 7": collinear */
@@ -309,7 +309,7 @@ static void test_repairs(void **state)
     write_text("fin.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 -1 0\nv 0 0 1\n"
                           "f 1 2 3\nf 2 1 4\nf 1 2 5\n",
                path, sizeof path);
-    assert_int_equal(cs_mesh_import(path, NULL, &m, &r, err, sizeof err), CS_IMPORT_OK);
+    assert_int_equal(cs_mesh_import(path, NULL, &m, &r, err, sizeof err), CS_OK);
     assert_int_equal(r.nonmanifold_edges, 1);
     assert_false(r.closed);
     cs_trimesh_destroy(m);
@@ -346,7 +346,7 @@ static void expect_bad(const char *path, const char *node, const char *want)
     cs_mesh_report r;
     cs_mesh_placement pl = cs_default_mesh_placement();
     pl.node = node;
-    assert_int_equal(cs_mesh_import(path, &pl, &m, &r, err, sizeof err), CS_IMPORT_BAD_INPUT);
+    assert_int_equal(cs_mesh_import(path, &pl, &m, &r, err, sizeof err), CS_ERR_BAD_INPUT);
     assert_null(m);
     assert_null(strchr(err, '\n'));
     if (!strstr(err, want))
@@ -484,11 +484,11 @@ static void test_bad_large_files(void **state)
     cs_mesh_report r;
     int rc = cs_mesh_import(path, NULL, &m, &r, err, sizeof err);
     unsetenv("CLOTHSIM_IMPORT_MEMORY");
-    if (rc == CS_IMPORT_OK) {
+    if (rc == CS_OK) {
         assert_true(r.triangles_read < 1368);   /* spider.fbx: 1368 */
         cs_trimesh_destroy(m);
     } else {
-        assert_int_equal(rc, CS_IMPORT_BAD_INPUT);
+        assert_int_equal(rc, CS_ERR_BAD_INPUT);
         assert_non_null(strstr(err, "more than 512 MB of memory"));
     }
 }
@@ -513,12 +513,12 @@ static void test_misread_files(void **state)
     cs_mesh_report r;
     cs_mesh_placement pl = cs_default_mesh_placement();
     snprintf(path, sizeof path, "%s/tests/data/bad_meshes/stl_in_millimetres.stl", CS_SOURCE_DIR);
-    assert_int_equal(cs_mesh_import(path, &pl, &m, &r, err, sizeof err), CS_IMPORT_OK);
+    assert_int_equal(cs_mesh_import(path, &pl, &m, &r, err, sizeof err), CS_OK);
     cs_trimesh_destroy(m);
     assert_non_null(strstr(r.size_warning, "150 m across"));
     assert_non_null(strstr(r.size_warning, "units: mm"));
     pl.unit_scale = 0.001;   /* units: mm */
-    assert_int_equal(cs_mesh_import(path, &pl, &m, &r, err, sizeof err), CS_IMPORT_OK);
+    assert_int_equal(cs_mesh_import(path, &pl, &m, &r, err, sizeof err), CS_OK);
     cs_trimesh_destroy(m);
     assert_string_equal(r.size_warning, "");
     assert_near(r.max[0] - r.min[0], 0.15, 1e-9);

@@ -129,7 +129,7 @@ static void round_trip(cs_mesh_format format, int nviews)
     snprintf(tmp, sizeof tmp, "%s.tmp", path);
 
     int rc = cs_mesh_write(path, format, nviews, f.views, err, sizeof err);
-    if (rc != CS_IMPORT_OK)
+    if (rc != CS_OK)
         fail_msg("write %s: %s", path, err);
     assert_true(exists(path));
     assert_false(exists(tmp));   /* written beside, then renamed */
@@ -143,7 +143,7 @@ static void round_trip(cs_mesh_format format, int nviews)
     /* Writing again replaces the file and still leaves no .tmp behind. */
     f.grid_x[1] += 0.125;
     rc = cs_mesh_write(path, format, nviews, f.views, err, sizeof err);
-    assert_int_equal(rc, CS_IMPORT_OK);
+    assert_int_equal(rc, CS_OK);
     assert_false(exists(tmp));
     got = cs_mesh_read(path, err, sizeof err);
     assert_non_null(got);
@@ -184,7 +184,7 @@ static void test_vertex_order_kept(void **state)
         char name[32], path[512], err[512] = "";
         snprintf(name, sizeof name, "order.%s", cs_mesh_format_extension(formats[i]));
         path_in_dir(path, sizeof path, name);
-        assert_int_equal(cs_mesh_write(path, formats[i], 1, f.views, err, sizeof err), CS_IMPORT_OK);
+        assert_int_equal(cs_mesh_write(path, formats[i], 1, f.views, err, sizeof err), CS_OK);
         cs_trimesh *got = cs_mesh_read(path, err, sizeof err);
         assert_non_null(got);
         assert_int_equal(got->nv, 12);
@@ -210,10 +210,10 @@ static void test_read_named(void **state)
         snprintf(name, sizeof name, "named.%s", cs_mesh_format_extension(formats[i]));
         path_in_dir(path, sizeof path, name);
         assert_int_equal(cs_mesh_write(path, formats[i], 2, f.views, err, sizeof err),
-                         CS_IMPORT_OK);
+                         CS_OK);
         const char *names[2] = {"tetra", "sheet"};
         cs_trimesh *got[2] = {NULL, NULL};
-        if (cs_mesh_read_named(path, 2, names, got, err, sizeof err) != CS_IMPORT_OK)
+        if (cs_mesh_read_named(path, 2, names, got, err, sizeof err) != CS_OK)
             fail_msg("read %s by name: %s", path, err);
         assert_same_mesh(got[0], &f.views[1], 1);
         assert_same_mesh(got[1], &f.views[0], 1);
@@ -221,7 +221,7 @@ static void test_read_named(void **state)
         cs_trimesh_destroy(got[1]);
         const char *missing[2] = {"sheet", "nothing"};
         assert_int_equal(cs_mesh_read_named(path, 2, missing, got, err, sizeof err),
-                         CS_IMPORT_BAD_INPUT);
+                         CS_ERR_BAD_INPUT);
         assert_null(got[0]);
         assert_non_null(strstr(err, "'nothing'"));
     }
@@ -235,7 +235,7 @@ static void test_write_bad_path(void **state)
     char err[512] = "";
     const char *path = "/nonexistent-dir/cs/frame.ply";
     int rc = cs_mesh_write(path, CS_MESH_PLY, 1, f.views, err, sizeof err);
-    assert_int_equal(rc, CS_IMPORT_BAD_INPUT);
+    assert_int_equal(rc, CS_ERR_BAD_INPUT);
     assert_non_null(strstr(err, path));
     assert_non_null(strstr(err, "No such file"));
 }
@@ -249,13 +249,13 @@ static void test_write_bad_input(void **state)
     path_in_dir(path, sizeof path, "bad.ply");
 
     assert_int_equal(cs_mesh_write(path, CS_MESH_PLY, 0, f.views, err, sizeof err),
-                     CS_IMPORT_BAD_INPUT);
+                     CS_ERR_BAD_INPUT);
     assert_non_null(strstr(err, "no meshes"));
 
     f.grid_tri[5] = 12;   /* one past the last vertex */
     err[0] = '\0';
     assert_int_equal(cs_mesh_write(path, CS_MESH_PLY, 1, f.views, err, sizeof err),
-                     CS_IMPORT_BAD_INPUT);
+                     CS_ERR_BAD_INPUT);
     assert_non_null(strstr(err, "sheet"));
     assert_false(exists(path));
 }
@@ -276,7 +276,7 @@ static void test_points(void **state)
             char name[32], path[512], err[512] = "";
             snprintf(name, sizeof name, "points_%d.%s", n, cs_mesh_format_extension(formats[i]));
             path_in_dir(path, sizeof path, name);
-            if (cs_mesh_write(path, formats[i], n, views, err, sizeof err) != CS_IMPORT_OK)
+            if (cs_mesh_write(path, formats[i], n, views, err, sizeof err) != CS_OK)
                 fail_msg("write %s: %s", path, err);
             cs_trimesh *got = cs_mesh_read(path, err, sizeof err);
             if (!got)

@@ -222,7 +222,7 @@ static void test_roundtrip(void **state)
             snprintf(path, sizeof path, "%s/frame_%lu.%s", tmpdir, i,
                      cs_mesh_format_extension(formats[fi]));
             int rc = cs_mesh_write(path, formats[fi], f.nviews, f.views, err, sizeof err);
-            if (rc != CS_IMPORT_OK)
+            if (rc != CS_OK)
                 fail_msg("write %s: %s", path, err);
             if (formats[fi] == CS_MESH_PLY) {
                 int b = first_data_byte(path);

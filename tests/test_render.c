@@ -99,7 +99,7 @@ static cs_image *render(const cs_render_settings *st, int n, const cs_render_mes
     cs_image *img = cs_image_create(st->width, st->height);
     assert_non_null(img);
     int rc = cs_renderer_draw(r, n, m, cam, img, stats, err, sizeof err);
-    if (rc != CS_RENDER_OK)
+    if (rc != CS_OK)
         fail_msg("cs_renderer_draw (%s): %s", cs_render_engine_name(st->engine), err);
     cs_renderer_destroy(r);
     return img;
@@ -271,7 +271,7 @@ static void compare_reference(const cs_image *img, const char *name, double mean
     snprintf(ref_path, sizeof ref_path, "%s/tests/reference/%s.png", CS_SOURCE_DIR, name);
     const char *update = getenv("CS_UPDATE_REFERENCES");
     if (update && *update && strcmp(update, "0") != 0) {
-        assert_int_equal(cs_image_write_png(img, ref_path, err, sizeof err), CS_RENDER_OK);
+        assert_int_equal(cs_image_write_png(img, ref_path, err, sizeof err), CS_OK);
         print_message("wrote reference %s\n", ref_path);
         return;
     }
@@ -380,7 +380,7 @@ static void expect_bad(cs_render_engine engine, int n, const cs_render_mesh *m,
     assert_non_null(r);
     cs_image *img = cs_image_create(32, 24);
     int rc = cs_renderer_draw(r, n, m, cam, img, NULL, err, sizeof err);
-    if (rc != CS_RENDER_BAD_INPUT || !strstr(err, needle))
+    if (rc != CS_ERR_BAD_INPUT || !strstr(err, needle))
         fail_msg("expected bad input mentioning '%s', got %d: %s", needle, rc, err);
     cs_image_destroy(img);
     cs_renderer_destroy(r);
@@ -394,13 +394,13 @@ static void test_bad_input(void **state)
     assert_null(cs_renderer_create(&st, err, sizeof err));
     assert_non_null(strstr(err, "size"));
     st = settings_for(CS_RENDER_PREVIEW, 100000, 10, 1);
-    assert_int_equal(cs_render_settings_check(&st, err, sizeof err), CS_RENDER_BAD_INPUT);
+    assert_int_equal(cs_render_settings_check(&st, err, sizeof err), CS_ERR_BAD_INPUT);
     assert_null(cs_renderer_create(&st, err, sizeof err));
     st = settings_for(CS_RENDER_EMBREE, 10, 10, 0);
-    assert_int_equal(cs_render_settings_check(&st, err, sizeof err), CS_RENDER_BAD_INPUT);
+    assert_int_equal(cs_render_settings_check(&st, err, sizeof err), CS_ERR_BAD_INPUT);
     assert_null(cs_image_create(0, 5));
     assert_int_equal(cs_render_png("x.png", 0, NULL, NULL, NULL, err, sizeof err),
-                     CS_RENDER_FAILED);
+                     CS_ERR_FAILED);
 
     test_scene s;
     scene_make(&s);
@@ -454,7 +454,7 @@ static void test_png_and_helpers(void **state)
     for (int i = 0; i < 3 * 37 * 21; i++)
         img->rgb[i] = (unsigned char)(i * 7);
     assert_int_equal(cs_image_write_png(img, "test_render_io.png", err, sizeof err),
-                     CS_RENDER_OK);
+                     CS_OK);
     cs_image *back = cs_image_read_png("test_render_io.png", err, sizeof err);
     assert_non_null(back);
     assert_int_equal(back->width, 37);
@@ -463,7 +463,7 @@ static void test_png_and_helpers(void **state)
     assert_null(cs_image_read_png("no/such/file.png", err, sizeof err));
     assert_non_null(strstr(err, "No such file"));
     assert_int_equal(cs_image_write_png(img, "no/such/dir/x.png", err, sizeof err),
-                     CS_RENDER_FAILED);
+                     CS_ERR_FAILED);
 
     cs_image *small = cs_image_shrink(img, 10);
     assert_non_null(small);
@@ -473,7 +473,7 @@ static void test_png_and_helpers(void **state)
     const char *labels[3] = {"a", "b", "c"};
     assert_int_equal(cs_render_contact_sheet("test_render_sheet.png", 3, three, labels, 2, 20,
                                              err, sizeof err),
-                     CS_RENDER_OK);
+                     CS_OK);
     cs_image *sheet = cs_image_read_png("test_render_sheet.png", err, sizeof err);
     assert_non_null(sheet);
     assert_int_equal(sheet->width, 2 * (20 + 6) + 6);
@@ -506,7 +506,7 @@ static void test_png_and_helpers(void **state)
     /* Automatic framing sees the whole box. */
     double lo[3] = {-1, 0, -0.5}, hi[3] = {1, 0.4, 0.5};
     cs_render_camera f = cs_render_camera_frame(lo, hi, 4.0 / 3.0);
-    assert_int_equal(cs_render_camera_check(&f, err, sizeof err), CS_RENDER_OK);
+    assert_int_equal(cs_render_camera_check(&f, err, sizeof err), CS_OK);
     for (int k = 0; k < 8; k++) {
         double p[3] = {k & 1 ? hi[0] : lo[0], k & 2 ? hi[1] : lo[1], k & 4 ? hi[2] : lo[2]};
         assert_true(cs_render_camera_project(&f, 160, 120, p, px));

@@ -297,7 +297,7 @@ static void test_defaults(void **state)
     cs_scene *s = NULL;
     assert_int_equal(cs_scene_load_string("cloths: [{grid: {}}]\n", NULL, 0, NULL, &s, err,
                                           sizeof err),
-                     CS_IMPORT_OK);
+                     CS_OK);
     cs_sim_def def = cs_default_sim_def();
     assert_string_equal(s->name, "scene");
     assert_string_equal(s->path, "<string>");
@@ -419,14 +419,14 @@ static void test_files(void **state)
     assert_non_null(mkdtemp(dir));
 
     snprintf(path, sizeof path, "%s/missing.yaml", dir);
-    assert_int_equal(cs_scene_load(path, 0, NULL, &s, err, sizeof err), CS_IMPORT_BAD_INPUT);
+    assert_int_equal(cs_scene_load(path, 0, NULL, &s, err, sizeof err), CS_ERR_BAD_INPUT);
     assert_null(s);
     char want[512];
     snprintf(want, sizeof want, "%s: cannot read: No such file or directory", path);
     assert_string_equal(err, want);
 
     /* a directory opens but does not read */
-    assert_int_equal(cs_scene_load(dir, 0, NULL, &s, err, sizeof err), CS_IMPORT_BAD_INPUT);
+    assert_int_equal(cs_scene_load(dir, 0, NULL, &s, err, sizeof err), CS_ERR_BAD_INPUT);
     snprintf(want, sizeof want, "%s: cannot read: Is a directory", dir);
     assert_string_equal(err, want);
 
@@ -435,7 +435,7 @@ static void test_files(void **state)
     assert_non_null(f);
     fputs("cloths:\n  - grid: {resolution: [2, 2]}\n", f);
     fclose(f);
-    assert_int_equal(cs_scene_load(path, 0, NULL, &s, err, sizeof err), CS_IMPORT_OK);
+    assert_int_equal(cs_scene_load(path, 0, NULL, &s, err, sizeof err), CS_OK);
     assert_string_equal(s->name, "my_scene");   /* the file's stem */
     assert_string_equal(s->path, path);
     cs_scene_destroy(s);
@@ -445,7 +445,7 @@ static void test_files(void **state)
     fputs("cloths:\n  - grid: {resolution: [2, 2]}\nbodies:\n  - shape: sphere\n    radius: 0\n",
           f);
     fclose(f);
-    assert_int_equal(cs_scene_load(path, 0, NULL, &s, err, sizeof err), CS_IMPORT_BAD_INPUT);
+    assert_int_equal(cs_scene_load(path, 0, NULL, &s, err, sizeof err), CS_ERR_BAD_INPUT);
     snprintf(want, sizeof want, "%s:5: bodies[0].radius: must be > 0 (got 0)", path);
     assert_string_equal(err, want);
 
@@ -466,9 +466,9 @@ static void test_shipped_scenes(void **state)
     for (size_t i = 0; i < g.gl_pathc; i++) {
         cs_scene *s = NULL;
         int rc = cs_scene_load(g.gl_pathv[i], 0, NULL, &s, err, sizeof err);
-        if (rc != CS_IMPORT_OK)
+        if (rc != CS_OK)
             print_error("%s\n", err);
-        assert_int_equal(rc, CS_IMPORT_OK);
+        assert_int_equal(rc, CS_OK);
         cs_scene_destroy(s);
     }
     globfree(&g);

@@ -56,7 +56,7 @@ static void expect_error_prefix(const char *text, const char *want)
     char err[1024] = "";
     cs_scene *s = NULL;
     assert_int_equal(cs_scene_load_string(text, "scenes/a.yaml", 0, NULL, &s, err, sizeof err),
-                     CS_IMPORT_BAD_INPUT);
+                     CS_ERR_BAD_INPUT);
     if (strncmp(err, want, strlen(want)) != 0)
         print_error("got:  %s\nwant: %s...\n", err, want);
     assert_int_equal(strncmp(err, want, strlen(want)), 0);
@@ -126,7 +126,7 @@ static void test_relative_path(void **state)
     fputs("cloths:\n  - mesh: {file: ../square.obj, units: cm}\n", f);
     fclose(f);
     cs_scene *s = NULL;
-    assert_int_equal(cs_scene_load(path, 0, NULL, &s, err, sizeof err), CS_IMPORT_OK);
+    assert_int_equal(cs_scene_load(path, 0, NULL, &s, err, sizeof err), CS_OK);
     assert_int_equal(s->def.cloths[0].mesh->nt, 2);   /* triangulated */
     assert_true(fabs(s->def.cloths[0].mesh->x[3] - 0.01) < 1e-12 ||
                 fabs(s->def.cloths[0].mesh->x[6] - 0.01) < 1e-12);
