@@ -409,9 +409,15 @@ static void print_plan(const cs_scene *scene, const cs_sim *sim, FILE *out)
     fprintf(out, "  (limits at rest: undamped 2/omega_max %.6g s by Lanczos iterations, %.6g s "
             "by Gershgorin's bound; the damped scheme's %.6g s)\n", cs_sim_undamped_dt(sim),
             cs_sim_gershgorin_dt(sim), cs_sim_damped_dt(sim));
-    if (!(scene->def.dt > 0) && scene->def.step_limit == CS_STEP_DAMPED)
-        fprintf(out, "  time.step_limit damped: the step is chosen again before every outer "
-                "step, smaller where the cloth is stretched\n");
+    if (!(scene->def.dt > 0)) {
+        bool damped = cs_sim_step_limit(sim) == CS_STEP_DAMPED;
+        fprintf(out, "  time.step_limit %s%s", scene->def.step_limit == CS_STEP_AUTO ? "auto: " : "",
+                damped ? "damped" : "undamped");
+        if (damped)
+            fprintf(out, ": the step is chosen again before every outer step, smaller where "
+                    "the cloth is stretched");
+        fputc('\n', out);
+    }
     if (scene->def.self_collision && scene->def.self.pruning == CS_PRUNING_PATH)
         fprintf(out, "  self_collision.pruning path: step A keeps only the pairs whose straight "
                 "relative paths come within the thickness\n");
@@ -792,6 +798,8 @@ int cs_run_main(int argc, char **argv)
     s->frames_requested = scene->frames;
     s->fps = scene->def.fps;
     s->dt = cs_sim_dt(r.sim);
+    if (!(scene->def.dt > 0))
+        s->step_limit = cs_sim_step_limit(r.sim) == CS_STEP_DAMPED ? "damped" : "undamped";
     s->steps_per_frame = steps_per_frame(scene->def.fps, s->dt);
     s->particles = cs_sim_particle_count(r.sim);
     s->springs = cs_sim_spring_count(r.sim);

@@ -150,6 +150,8 @@ static cJSON *build_json(const cs_summary *s, builder *b)
     add_num(b, root, "frames_written", s->frames_written);
     add_num(b, root, "fps", s->fps);
     add_num(b, root, "dt", s->dt);
+    if (s->step_limit)
+        add_str(b, root, "step_limit", s->step_limit);
     add_num(b, root, "steps_per_frame", s->steps_per_frame);
     add_num(b, root, "particles", s->particles);
     add_num(b, root, "triangles", s->triangles);

@@ -61,6 +61,8 @@ typedef struct cs_summary {
     bool self_collision;             /* frames carry the self-collision counters */
     bool scripts;                    /* frames carry script_lag */
     const char *script_zones;        /* self_collision.script_zones, with scripts */
+    const char *step_limit;          /* the limit the automatic step used, auto resolved;
+                                      * NULL with a fixed time.dt */
     double script_lag_max;           /* s, the most any script fell behind its keys */
     int failed_frame;                /* the frame that went unstable, else -1 */
     int frames_requested;            /* simulated frames asked for */

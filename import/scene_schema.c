@@ -39,6 +39,7 @@ static const cyaml_strval_t friction_names[] = {
 static const cyaml_strval_t step_limit_names[] = {
     {"undamped", CS_STEP_UNDAMPED},
     {"damped", CS_STEP_DAMPED},
+    {"auto", CS_STEP_AUTO},
 };
 static const cyaml_strval_t scheme_names[] = {
     {"fixed", CS_COLLISION_FIXED},

@@ -81,7 +81,7 @@ static int outer_step(cs_sim *sim, int k)
 
 static bool adaptive_step(const cs_sim *sim)
 {
-    return !(sim->def.dt > 0) && sim->def.step_limit == CS_STEP_DAMPED;
+    return !(sim->def.dt > 0) && sim->step_limit == CS_STEP_DAMPED;
 }
 
 /* The step for the rest of a frame: the frame's remaining time in equal

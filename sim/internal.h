@@ -119,7 +119,8 @@ struct cs_sim {
                                    * paper's repulsion thickness) */
     double frame_end;             /* advance_frame's end time: a step that
                                    * lands within round-off of it lands on it */
-    double stable_dt;             /* the limit def.step_limit names, at rest */
+    cs_step_limit step_limit;     /* def.step_limit with auto resolved */
+    double stable_dt;             /* the limit step_limit names, at rest */
     double damped_dt;             /* the damped scheme's limit at rest (step_limit.c) */
     double undamped_dt;           /* 2 / omega_max, omega_max^2 by Lanczos */
     double gershgorin_dt;         /* the same from Gershgorin's bound (smaller) */

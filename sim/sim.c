@@ -48,6 +48,7 @@ cs_sim_def cs_default_sim_def(void)
     d.fps = 24;
     d.dt = 0;
     d.dt_safety = 0.5;
+    d.step_limit = CS_STEP_AUTO;
     d.collision_steps = 16;
     d.cg_tolerance = 1e-3;
     d.cg_max_iterations = 1000;
@@ -100,8 +101,9 @@ static int validate(const cs_sim_def *def, char *err, size_t errlen)
         return fail(err, errlen, "fps must be > 0");
     if (!(def->dt >= 0) || !(def->dt_safety > 0 && def->dt_safety <= 1))
         return fail(err, errlen, "dt must be >= 0 and dt_safety in (0, 1]");
-    if (def->step_limit != CS_STEP_UNDAMPED && def->step_limit != CS_STEP_DAMPED)
-        return fail(err, errlen, "step_limit must be undamped or damped");
+    if (def->step_limit != CS_STEP_UNDAMPED && def->step_limit != CS_STEP_DAMPED &&
+        def->step_limit != CS_STEP_AUTO)
+        return fail(err, errlen, "step_limit must be undamped, damped or auto");
     if (def->collision_steps < 1 || !(def->cg_tolerance > 0) || def->cg_max_iterations < 1)
         return fail(err, errlen, "collision_steps, cg_tolerance and cg_max_iterations must be positive");
     if (!finite3(def->gravity))
@@ -508,6 +510,7 @@ double cs_sim_dt(const cs_sim *sim) { return sim->dt; }
 double cs_sim_stable_dt(const cs_sim *sim) { return sim->stable_dt; }
 double cs_sim_undamped_dt(const cs_sim *sim) { return sim->undamped_dt; }
 double cs_sim_damped_dt(const cs_sim *sim) { return sim->damped_dt; }
+cs_step_limit cs_sim_step_limit(const cs_sim *sim) { return sim->step_limit; }
 double cs_sim_gershgorin_dt(const cs_sim *sim) { return sim->gershgorin_dt; }
 int cs_sim_particle_count(const cs_sim *sim) { return sim->n; }
 int cs_sim_spring_count(const cs_sim *sim) { return sim->nsprings; }

@@ -223,6 +223,8 @@ typedef enum cs_step_limit {
     CS_STEP_DAMPED,       /* dt_safety x the damped scheme's limit at the current
                            * tension, chosen before every outer step (step_limit.c):
                            * larger steps, less accurate contact and friction */
+    CS_STEP_AUTO,         /* damped where the cloth's damping makes its limit at rest
+                           * several times the undamped one, else undamped */
 } cs_step_limit;
 
 typedef enum cs_friction_method {
@@ -496,6 +498,8 @@ double cs_sim_dt(const cs_sim *sim);          /* step used by advance_frame */
  * Gershgorin. */
 double cs_sim_stable_dt(const cs_sim *sim);
 double cs_sim_damped_dt(const cs_sim *sim);
+/* the limit the automatic step uses: def.step_limit, auto resolved */
+cs_step_limit cs_sim_step_limit(const cs_sim *sim);
 double cs_sim_undamped_dt(const cs_sim *sim);
 double cs_sim_gershgorin_dt(const cs_sim *sim);
 int cs_sim_particle_count(const cs_sim *sim);

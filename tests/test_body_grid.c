@@ -137,6 +137,7 @@ static cs_sim *drop_sheet(const cs_body_def *bodies, int nbodies, cs_trimesh **m
     def.bodies = bodies;
     def.nbodies = nbodies;
     def.friction_method = method;
+    def.step_limit = CS_STEP_UNDAMPED; /* the contact counts below are per step */
     char err[256];
     cs_sim *sim = cs_sim_create(&def, err, sizeof err);
     assert_non_null(sim);
