@@ -46,6 +46,7 @@ typedef struct job {
     char **samples;             /* USD: per cloth its temporary file of samples */
     FILE **sample_fp;
     cs_pc2 *pc2;                /* per cloth */
+    int **tri;                  /* per cloth frame 0's triangles: the topology */
     char *usd_path;
     float *xf;                  /* one cloth's positions as float32 */
 } job;
@@ -94,6 +95,9 @@ static void job_free(job *j)
     close_all(j, true);
     for (int c = 0; j->samples && c < j->ncloths; c++)
         free(j->samples[c]);
+    for (int c = 0; j->tri && c < j->ncloths; c++)
+        free(j->tri[c]);
+    free(j->tri);
     free(j->samples);
     free(j->sample_fp);
     free(j->pc2);
@@ -142,10 +146,26 @@ static int add_frame(job *j, const cs_frame_layout *layout, const char *frames_d
     int status = cs_frame_read(layout, frames_dir, f, meshes, err, errlen);
     for (int c = 0; c < j->ncloths && status == CS_EXIT_OK; c++) {
         const cs_trimesh *scene_mesh = j->scene->def.cloths[c].mesh, *m = meshes[c];
-        if (!m || m->nv != scene_mesh->nv) {
+        if (!m || m->nv != scene_mesh->nv || m->nt != scene_mesh->nt) {
             cs_errorf(err, errlen, "frame %d of %s does not hold the scene's cloth '%s' "
-                      "(vertex counts differ): the scene changed since the run", f, j->dir,
-                      layout->names[c]);
+                      "(vertex or triangle counts differ): the scene changed since the run", f,
+                      j->dir, layout->names[c]);
+            status = CS_EXIT_INPUT;
+            break;
+        }
+        /* the points and triangles as the file holds them: a format may
+         * order the vertices its own way (OBJ), the same in every frame */
+        size_t tri_bytes = 3 * sizeof *m->tri * (size_t)m->nt;
+        if (f == 0 && (j->tri[c] = malloc(tri_bytes + 1)))
+            memcpy(j->tri[c], m->tri, tri_bytes);
+        if (!j->tri[c]) {
+            cs_errorf(err, errlen, "out of memory");
+            status = CS_EXIT_OUTPUT;
+            break;
+        }
+        if (memcmp(j->tri[c], m->tri, tri_bytes) != 0) {
+            cs_errorf(err, errlen, "frame %d of %s: cloth '%s' has other triangles than in "
+                      "frame 0", f, j->dir, layout->names[c]);
             status = CS_EXIT_INPUT;
             break;
         }
@@ -157,8 +177,8 @@ static int add_frame(job *j, const cs_frame_layout *layout, const char *frames_d
             cs_pc2_add(&j->pc2[c], j->xf);
             char path[4096];
             snprintf(path, sizeof path, "%s/pc2/%s.obj", j->dir, cloth_name(j, c));
-            if (f == 0 && cs_rest_obj_write(path, cloth_name(j, c), m->nv, j->xf, scene_mesh->nt,
-                                            scene_mesh->tri, err, errlen) != 0)
+            if (f == 0 && cs_rest_obj_write(path, cloth_name(j, c), m->nv, j->xf, m->nt,
+                                            j->tri[c], err, errlen) != 0)
                 status = CS_EXIT_OUTPUT;
         }
     }
@@ -254,9 +274,8 @@ static int fill_usd(const char *tmp, void *ctx, char *why, size_t whylen)
     cs_usd_begin_stage(fp, &stage);
     bool ok = true;
     for (int c = 0; c < j->ncloths && ok; c++) {
-        const cs_trimesh *m = s->def.cloths[c].mesh;
         cs_usd_begin_mesh(fp, j->prims[c], s->def.cloths[c].name ? s->def.cloths[c].name : "",
-                          m->nt, m->tri, s->cloth_colors + 3 * c);
+                          s->def.cloths[c].mesh->nt, j->tri[c], s->cloth_colors + 3 * c);
         cs_usd_begin_points_samples(fp);
         ok = copy_file(j->samples[c], fp);
         cs_usd_end_samples(fp);
@@ -315,6 +334,7 @@ int cs_export_run(const cs_scene *scene, cs_mesh_format format, const char *dir,
     j.samples = calloc(n, sizeof *j.samples);
     j.sample_fp = calloc(n, sizeof *j.sample_fp);
     j.pc2 = calloc(n, sizeof *j.pc2);
+    j.tri = calloc(n, sizeof *j.tri);
     j.xf = malloc(3 * sizeof *j.xf * ((size_t)maxnv + 1));
     j.usd_path = cs_path_join(dir, "cloth.usda");
     const char **names = calloc(n, sizeof *names);
@@ -324,7 +344,7 @@ int cs_export_run(const cs_scene *scene, cs_mesh_format format, const char *dir,
     for (int c = 0; names && c < j.ncloths; c++)
         names[c] = scene->def.cloths[c].name;
     int status = CS_EXIT_OK;
-    if (!j.prims || !j.samples || !j.sample_fp || !j.pc2 || !j.xf || !j.usd_path || !names ||
+    if (!j.prims || !j.samples || !j.sample_fp || !j.pc2 || !j.tri || !j.xf || !j.usd_path || !names ||
         !meshes || cs_frame_layout_init(&layout, format, j.ncloths, names) != 0) {
         cs_errorf(err, errlen, "out of memory");
         status = CS_EXIT_OUTPUT;

@@ -4,7 +4,7 @@
 // parse of its own, against the frame files (tests/cli_usd.sh).
 //
 // SPEC: {root, up, fps, start, end, times: [t1, t2], meshes: [{name,
-// points, faces, samples, frames: [PLY of time code t, with %04d]}],
+// points, faces, samples, frames: PLY or OBJ of time code t, with %04d}],
 // bodies: [{name, samples}]}; bodies are meshes too, whose points are not
 // sampled (samples: transform samples, 0 for a static body).
 //
@@ -50,7 +50,36 @@ function readPly(file) {
     for (let v = 0; v < nv; v++)
         for (let k = 0; k < 3; k++)
             x[3 * v + k] = buf.readFloatLE(base + v * stride + offsets['xyz'[k]]);
-    return x;
+    // the faces, as assimp writes them: a list of uchar count, int indices
+    const tri = [];
+    if (header.includes('property list uchar int vertex_index'))
+        for (let o = base + nv * stride; o < buf.length;) {
+            const n = buf.readUInt8(o);
+            for (let k = 0; k < n; k++) tri.push(buf.readInt32LE(o + 1 + 4 * k));
+            o += 1 + 4 * n;
+        }
+    return {x, tri};
+}
+
+// OBJ frames: `v x y z` and `f a/b/c ...` lines (1-based)
+function readObj(file) {
+    const xs = [], tri = [];
+    for (const line of fs.readFileSync(file, 'utf8').split('\n')) {
+        const w = line.trim().split(/\s+/);
+        if (w[0] === 'v') xs.push(+w[1], +w[2], +w[3]);
+        if (w[0] === 'f') for (const c of w.slice(1)) tri.push(parseInt(c, 10) - 1);
+    }
+    return {x: Float32Array.from(xs), tri};
+}
+const readFrame = file => file.endsWith('.obj') ? readObj(file) : readPly(file);
+
+// PLY frames hold float32 bits: equal. OBJ frames hold decimals, which
+// assimp's reader (clothsim's) and JavaScript's may round to neighbouring
+// float32 values (seen at 1e-16): within one float32 step.
+function sameFloat(a, b, text) {
+    a = Math.fround(a);
+    if (a === b || !text) return a === b;
+    return Math.abs(a - b) <= Math.max(Math.abs(a), Math.abs(b)) * 2 ** -23;
 }
 const framePath = (pattern, t) => pattern.replace('%04d', String(t).padStart(4, '0'));
 
@@ -73,10 +102,12 @@ function parseUsda(text) {
         let m;
         if ((m = line.match(/^\s*def Xform "(\w+)"/)) && !mesh) meta.rootPrim = m[1];
         if ((m = line.match(/^\s*def Mesh "(\w+)"/))) {
-            mesh = meshes[m[1]] = {samples: new Map(), xformSamples: 0, name: null};
+            mesh = meshes[m[1]] = {samples: new Map(), xformSamples: 0, name: null, tri: []};
             continue;
         }
         if (!mesh) continue;
+        if ((m = line.match(/int\[\] faceVertexIndices = \[(.*)\]/)))
+            mesh.tri = m[1].split(',').map(Number);
         // a string in double or single quotes (TinyUSDZ prints 'say "hi"')
         if ((m = line.match(/custom string clothsim:name = (?:"((?:[^"\\]|\\.)*)"|'((?:[^'\\]|\\.)*)')/)))
             mesh.name = (m[1] ?? m[2]).replace(/\\(.)/g, '$1');
@@ -120,19 +151,30 @@ function checkStage(stage, who) {
         check(codes[0] === spec.start && codes[codes.length - 1] === spec.end,
               `${who}: ${s.name}'s samples run ${codes[0]} to ${codes[codes.length - 1]}`);
         for (const t of spec.times) {
-            const x = m.samples.get(t), ref = readPly(framePath(s.frames, t));
+            const file = framePath(s.frames, t), text = file.endsWith('.obj');
+            const x = m.samples.get(t), frame = readFrame(file), ref = frame.x;
             if (!check(x, `${who}: ${s.name} has no sample at ${t}`)) continue;
             check(x.length === 3 * s.points, `${who}: ${s.name} at ${t}: ${x.length / 3} points`);
             let bad = -1;
             for (let i = 0; i < ref.length && bad < 0; i++)
-                if (Math.fround(x[i]) !== ref[i]) bad = i;
+                if (!sameFloat(x[i], ref[i], text)) bad = i;
             check(x.length === ref.length && bad < 0,
                   `${who}: ${s.name} at ${t}: coordinate ${bad} is ${x[bad]}, the frame file's ` +
                   `${ref[bad]}`);
+            // the topology: every triangle's corners where the frame has them
+            let badTri = -1;
+            for (let i = 0; i < frame.tri.length && badTri < 0; i++)
+                for (let k = 0; k < 3; k++)
+                    if (!sameFloat(x[3 * m.tri[i] + k], ref[3 * frame.tri[i] + k], text)) badTri = i;
+            check(frame.tri.length === 3 * s.faces && m.tri.length === frame.tri.length &&
+                  badTri < 0, `${who}: ${s.name} at ${t}: corner ${badTri} of the triangles ` +
+                  `is not the frame file's`);
         }
         console.log(`${who}: ${s.name}: ${m.samples.size} samples, codes ${codes[0]} to ` +
-                    `${codes[codes.length - 1]}; ${s.points} points equal frames ` +
-                    `${spec.times.join(' and ')} as float32`);
+                    `${codes[codes.length - 1]}; ${s.points} points and ${s.faces} triangles ` +
+                    (s.frames.endsWith('.obj') ? 'within a float32 step of the OBJ frames '
+                                               : 'equal to the float32 of frames ') +
+                    spec.times.join(' and '));
     }
     for (const b of spec.bodies) {
         const m = meshes[b.name];
