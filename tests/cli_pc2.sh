@@ -4,7 +4,8 @@
 # cache, whose header is right and whose every float32 is bit for bit the
 # frame files' (read here from the PLY frames), beside NAME.obj, the rest
 # pose: frame 0's positions as the same float32 values, and the scene's
-# triangles in the cache's point order.
+# triangles in the cache's point order. A new run into the folder removes
+# them.
 set -eu
 
 NAME=cli_pc2
@@ -87,6 +88,11 @@ grep -q 'point caches and their rest poses: two/pc2/' out.txt || fail "run does 
 ls two/pc2/*.tmp >/dev/null 2>&1 && fail "temporary files left in two/pc2/"
 compare two 4 top_sheet:top_sheet under:under >cmp.txt
 cat cmp.txt
+# a new run into the folder takes the old caches away with the old frames
+cp -r two two_again
+run 0 run two.yaml -o two_again -q --frames 1
+[ -z "$(ls two_again/pc2)" ] || fail "a new run left the caches of the last: $(ls two_again/pc2)"
+[ -s two_again/cloth.usda ] || fail "no two_again/cloth.usda"
 
 # the drape, written by export after the run (output.pc2 off by default)
 run 0 run "$2/scenes/drape.yaml" -o drape -q --frames 3 --set 'cloths.0.grid.resolution=[12,12]'
