@@ -4,6 +4,7 @@
  * own file (run.c, render_cmd.c, ...). A new command, or a help topic
  * (`clothsim help scene`: a row with topic set), is a new row. */
 #include "app/cli.h"
+#include "app/export_cmd.h"
 #include "app/info_cmd.h"
 #include "app/input_check.h"
 #include "app/intersections_cmd.h"
@@ -37,6 +38,9 @@ static const cs_command COMMANDS[] = {
     {.name = "info", .synopsis = "info DIR",
      .summary = "a run's frames as a table (pairs, energy, speed) and DIR/info.png",
      .main = cs_info_main, .help = cs_info_help},
+    {.name = "export", .synopsis = "export DIR",
+     .summary = "a run's frames as one animated USD stage or Blender point caches",
+     .main = cs_export_main, .help = cs_export_help},
     {.name = "render", .synopsis = "render TARGET",
      .summary = "render a run's frames (or a scene's start) to PNG images",
      .main = cs_render_main, .help = cs_render_help},

@@ -250,8 +250,37 @@ static int remove_file(const char *path, char *err, size_t errlen)
     return 0;
 }
 
+/* An earlier run's DIR/cloth.usda and the caches and rest poses of
+ * DIR/pc2/ (app/export.h): left, they would describe other frames. */
+static int remove_exports(const char *dir, char *err, size_t errlen)
+{
+    char path[4096];
+    snprintf(path, sizeof path, "%s/cloth.usda", dir);
+    DIR *d = NULL;
+    int rc = unlink(path) != 0 && errno != ENOENT ? -1 : 0;
+    if (rc == 0) {
+        snprintf(path, sizeof path, "%s/pc2", dir);
+        d = opendir(path); /* NULL: none */
+    }
+    struct dirent *e;
+    while (d && rc == 0 && (e = readdir(d)) != NULL) {
+        size_t len = strlen(e->d_name);
+        const char *ext = len > 4 ? e->d_name + len - 4 : "";
+        if (strcmp(ext, ".pc2") != 0 && strcmp(ext, ".obj") != 0 && strcmp(ext, ".tmp") != 0)
+            continue;
+        snprintf(path, sizeof path, "%s/pc2/%s", dir, e->d_name);
+        rc = unlink(path) != 0 && errno != ENOENT ? -1 : 0;
+    }
+    if (rc != 0)
+        cs_errorf(err, errlen, "cannot remove %s: %s", path, strerror(errno));
+    if (d)
+        closedir(d);
+    return rc;
+}
+
 /* Makes the folders and takes the lock; a new run (keep false) then
- * removes an earlier run's frames, records and state. */
+ * removes an earlier run's frames, records and state (and what was
+ * exported from its frames). */
 static int open_dir(cs_outdir *o, bool keep, char *err, size_t errlen)
 {
     if (cs_make_dirs(o->frames_dir) != 0) {
@@ -268,7 +297,8 @@ static int open_dir(cs_outdir *o, bool keep, char *err, size_t errlen)
     char *state_tmp = cs_path_tmp(o->state_path);
     int rc = !state_tmp || remove_file(o->state_path, err, errlen) != 0 ||
                      remove_file(state_tmp, err, errlen) != 0 ||
-                     remove_frames(o->frames_dir, -1, err, errlen) != 0
+                     remove_frames(o->frames_dir, -1, err, errlen) != 0 ||
+                     remove_exports(o->dir, err, errlen) != 0
                  ? -1
                  : 0;
     if (!state_tmp)

@@ -12,7 +12,8 @@
  *                               named by their content
  *   DIR/.lock                   held while a run writes (lock.h)
  * A new run takes the folder over: frames, records and state of an earlier
- * run there are removed. --resume continues the earlier run instead.
+ * run there are removed, with DIR/cloth.usda and DIR/pc2/'s caches made
+ * from them (export.h). --resume continues the earlier run instead.
  *
  * A frame keeps its cloths apart, so that they read back by name: in OBJ
  * and glTF each cloth is an object of its own (a node and a mesh named like

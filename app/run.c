@@ -12,6 +12,7 @@
 
 #include "app/checkpoint.h"
 #include "app/cli.h"
+#include "app/export.h"
 #include "app/input_check.h"
 #include "app/outdir.h"
 #include "app/progress.h"
@@ -77,7 +78,9 @@ void cs_run_help(FILE *out)
         "                       DIR/frames.jsonl (a record per frame) and DIR/state.h5\n"
         "                       (what --resume needs); the frames, records and state\n"
         "                       of an earlier run in DIR are removed; one run at a time\n"
-        "                       (another run writing into DIR is refused, exit 4)\n"
+        "                       (another run writing into DIR is refused, exit 4);\n"
+        "                       at the end DIR/cloth.usda (output.usd, on) and DIR/pc2/\n"
+        "                       (output.pc2, off), even if stopped: 'clothsim help export'\n"
         "      --resume         continue the run in DIR from its last frame (after a\n"
         "                       kill, a crash or --frames K): the same scene and --set\n"
         "                       overrides are required (--frames may grow), and the\n"
@@ -523,6 +526,30 @@ static int start_output(run_state *r, cs_progress *progress)
     return CS_EXIT_OK;
 }
 
+/* Rank 0, after the last frame: DIR/cloth.usda and the point caches
+ * (output.usd, output.pc2) of the frames written, those of a run that
+ * stopped early too. Returns the run's status, or CS_EXIT_OUTPUT when a
+ * run that was ok could not write them. */
+static int export_frames(run_state *r, int status)
+{
+    cs_export_what what = {r->scene->output_usd, r->scene->output_pc2};
+    cs_summary *s = &r->summary;
+    if ((!what.usd && !what.pc2) || s->frames_written < 1)
+        return status;
+    char err[ERRLEN];
+    double t0 = cs_now();
+    int rc = cs_export_run(r->scene, r->format, r->out.dir, s->frames_written, r->scene->def.fps,
+                           what, NULL, err, sizeof err);
+    s->output_seconds += cs_now() - t0;
+    if (rc != CS_EXIT_OK)
+        fprintf(stderr, "clothsim: %s\n", err);
+    if (rc == CS_EXIT_OK || status != CS_EXIT_OK)
+        return status; /* the run's own failure comes first */
+    s->status = "failed";
+    s->error = "the USD stage or the point caches could not be written";
+    return CS_EXIT_OUTPUT;
+}
+
 /* Rank 0 writes, prints and decides; the others simulate their particles
  * and follow its decision after every frame (cs_sim_agree), so a failed
  * write or an interrupt stops every rank at the same frame. */
@@ -642,6 +669,8 @@ static int simulate(run_state *r, const run_options *o)
         frames_kept(s->frames_written, kept, sizeof kept);
         fprintf(stderr, "clothsim: interrupted; %s in %s\n", kept, r->frames_dir);
     }
+    if (status == CS_EXIT_OK || status == CS_EXIT_UNSTABLE || status == CS_EXIT_INTERRUPTED)
+        status = export_frames(r, status);
     if (write_summary(r, err, sizeof err) != 0 ||
         cs_outdir_sync(&r->out, true, err, sizeof err) != 0) {
         fprintf(stderr, "clothsim: %s\n", err);
@@ -652,6 +681,10 @@ static int simulate(run_state *r, const run_options *o)
     if (status == CS_EXIT_OK)
         printf("wrote %d frame file%s to %s, summary in %s\n", s->frames_written,
                s->frames_written == 1 ? "" : "s", r->frames_dir, r->summary_path);
+    if (status == CS_EXIT_OK && r->scene->output_usd)
+        printf("the frames as one animated USD stage: %s/cloth.usda\n", r->out.dir);
+    if (status == CS_EXIT_OK && r->scene->output_pc2)
+        printf("Blender point caches and their rest poses: %s/pc2/\n", r->out.dir);
     fflush(stdout);
     return status;
 }

@@ -107,25 +107,37 @@ typedef struct bytes {
     size_t len;
 } bytes;
 
-/* The bytes as tmp, every write checked (fwrite, fflush, fclose). */
-static int fill_bytes(const char *tmp, void *ctx, char *why, size_t whylen)
+FILE *cs_file_open_checked(const char *path, const char *mode, char *why, size_t whylen)
 {
-    const bytes *b = ctx;
     errno = 0;
-    FILE *fp = fopen(tmp, "wb");
-    if (!fp) {
-        snprintf(why, whylen, "%s", strerror(errno));
-        return -1;
-    }
-    int failed = fwrite(b->data, 1, b->len, fp) != b->len || fflush(fp) != 0 || ferror(fp);
+    FILE *fp = fopen(path, mode);
+    if (!fp && why)
+        snprintf(why, whylen, "%s", strerror(errno ? errno : EIO));
+    return fp;
+}
+
+int cs_file_close_checked(FILE *fp, char *why, size_t whylen)
+{
+    int failed = fflush(fp) != 0 || ferror(fp);
     int saved = errno;
     if (fclose(fp) != 0 && !failed) {
         failed = 1;
         saved = errno;
     }
-    if (failed)
+    if (failed && why)
         snprintf(why, whylen, "%s", strerror(saved ? saved : EIO));
     return failed ? -1 : 0;
+}
+
+/* The bytes as tmp, every write checked (fwrite, fflush, fclose). */
+static int fill_bytes(const char *tmp, void *ctx, char *why, size_t whylen)
+{
+    const bytes *b = ctx;
+    FILE *fp = cs_file_open_checked(tmp, "wb", why, whylen);
+    if (!fp)
+        return -1;
+    fwrite(b->data, 1, b->len, fp); /* a short write sets the error indicator */
+    return cs_file_close_checked(fp, why, whylen);
 }
 
 int cs_file_write_atomic(const char *path, const void *data, size_t len, char *err,

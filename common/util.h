@@ -14,6 +14,7 @@
 
 #include <stdbool.h>
 #include <stddef.h>
+#include <stdio.h>
 
 #ifdef __cplusplus
 extern "C" {
@@ -45,6 +46,14 @@ typedef int (*cs_file_filler)(const char *tmp, void *ctx, char *why, size_t whyl
  * why" in err and the temporary file removed. */
 int cs_write_atomic(const char *path, bool unique_tmp, cs_file_filler fill, void *ctx,
                     char *err, size_t errlen);
+
+/* fopen(path, mode), or NULL with the reason in why (when not NULL). */
+FILE *cs_file_open_checked(const char *path, const char *mode, char *why, size_t whylen);
+
+/* Flushes and closes fp, every step checked: returns 0, or -1 with the
+ * reason (the first error of the stream's writes, the flush or the close)
+ * in why (when not NULL). fp is closed either way. */
+int cs_file_close_checked(FILE *fp, char *why, size_t whylen);
 
 /* Writes len bytes as path atomically (cs_write_atomic). */
 int cs_file_write_atomic(const char *path, const void *data, size_t len, char *err,

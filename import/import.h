@@ -312,6 +312,8 @@ typedef struct cs_scene {
     char *path;                /* the file it came from ("<string>" if none) */
     int frames;                /* frames to simulate after the initial one */
     char *output_format;       /* "ply", "obj" or "glb" */
+    bool output_usd;           /* output.usd: `run` writes DIR/cloth.usda */
+    bool output_pc2;           /* output.pc2: `run` writes DIR/pc2/ */
     cs_camera_def camera;
     double *cloth_colors;      /* 3 per cloth, linear RGB in [0,1] */
     double *body_colors;       /* 3 per body */

@@ -400,7 +400,8 @@ int cs_sl_convert_scene(loader *L, const cs_raw_scene *r, const char *default_na
     if ((rc = convert_time(L, r->time, s)) ||
         (rc = cs_sl_vec(L, CS_SKEY(scene, gravity), r->gravity, "", NULL, s->def.gravity)) ||
         (rc = cs_sl_convert_keys(L, CS_SEC_effects, r->effects, "effects", &s->def)) ||
-        (rc = cs_sl_convert_keys(L, CS_SEC_check, r->check, "check", s)))
+        (rc = cs_sl_convert_keys(L, CS_SEC_check, r->check, "check", s)) ||
+        (rc = cs_sl_convert_keys(L, CS_SEC_output, r->output, "output", s)))
         goto fail;
     bool wind_effect =
         r->effects && r->effects->wind ? *r->effects->wind : CS_SKEY(effects, wind)->def(0) != 0;
