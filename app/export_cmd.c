@@ -6,6 +6,7 @@
 #include "app/export_cmd.h"
 
 #include "app/cli.h"
+#include "app/exit.h"
 #include "app/export.h"
 #include "app/lock.h"
 #include "app/run.h"
@@ -123,13 +124,13 @@ int cs_export_main(int argc, char **argv)
     const char *path = scene_path ? scene_path : info.scene_file;
     int rc = cs_scene_load(path, info.noverrides, (const char *const *)info.overrides, &scene,
                            err, sizeof err);
-    if (rc != CS_IMPORT_OK) {
+    if (rc != CS_OK) {
         fprintf(stderr, "clothsim export: %s\n", err[0] ? err : "cannot load the scene");
         if (access(path, R_OK) != 0)
             fprintf(stderr, "clothsim export: %s/summary.json names the scene file '%s'; run "
                             "from where the run was started, or give it with --scene FILE\n",
                     dir, path);
-        status = rc == CS_IMPORT_BAD_INPUT ? CS_EXIT_INPUT : CS_EXIT_OUTPUT;
+        status = cs_exit_status(rc);
         goto done;
     }
     /* a run writing frames now would be exported half done */
