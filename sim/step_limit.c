@@ -32,7 +32,7 @@
  *
  * The default (time.step_limit: auto) takes the damped limit when the
  * cloth's damping makes it at least AUTO_MIN_GAIN times the undamped one
- * at rest, as Table 1's overdamping does (about 20 times): then a step
+ * at rest, as Table 1's overdamping does (about 38 times): then a step
  * costs a little more (the bound before each outer step, more CG
  * iterations a solve) and a frame needs a fraction of the steps. Steps far
  * above the undamped limit are stable but less accurate where friction and
