@@ -428,12 +428,13 @@ static void print_plan(const cs_scene *scene, const cs_sim *sim, FILE *out)
     fprintf(out, "%d frames after the initial one: %.6g s of simulated time; %d particles\n",
             scene->frames, scene->def.fps > 0 ? scene->frames / scene->def.fps : 0.0,
             cs_sim_particle_count(sim));
-    /* the state, springs, level sets and every planned stage's arrays are
-     * allocated by now; only the pair and zone lists grow as cloth meets */
+    /* a plan holds the scene, the mesh, the bodies' level sets and the
+     * springs; a run adds the step's scratch (plan_only leaves it out) */
     struct rusage ru;
     if (getrusage(RUSAGE_SELF, &ru) == 0)
-        fprintf(out, "memory after setup: %.0f MiB at its peak (this process; steps A and C's "
-                "pair lists grow with the contacts during the run)\n", ru.ru_maxrss / 1024.0);
+        fprintf(out, "memory for the setup: %.0f MiB at its peak (this process); a run adds "
+                "the step's arrays and the pair lists, which grow with the contacts\n",
+                ru.ru_maxrss / 1024.0);
 }
 
 /* -------------------------------------------------------------- the run */
