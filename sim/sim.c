@@ -49,6 +49,9 @@ cs_sim_def cs_default_sim_def(void)
     d.dt = 0;
     d.dt_safety = 0.5;
     d.step_limit = CS_STEP_AUTO;
+    /* below 4x the damped step's per-step costs (a bound before every
+     * outer step, tension that shrinks it in contact) eat its gain */
+    d.auto_min_gain = 4;
     d.collision_steps = 16;
     d.cg_tolerance = 1e-3;
     d.cg_max_iterations = 1000;
@@ -104,6 +107,8 @@ static int validate(const cs_sim_def *def, char *err, size_t errlen)
     if (def->step_limit != CS_STEP_UNDAMPED && def->step_limit != CS_STEP_DAMPED &&
         def->step_limit != CS_STEP_AUTO)
         return fail(err, errlen, "step_limit must be undamped, damped or auto");
+    if (!(def->auto_min_gain >= 1))
+        return fail(err, errlen, "auto_min_gain must be at least 1");
     if (def->collision_steps < 1 || !(def->cg_tolerance > 0) || def->cg_max_iterations < 1)
         return fail(err, errlen, "collision_steps, cg_tolerance and cg_max_iterations must be positive");
     if (!finite3(def->gravity))

@@ -311,6 +311,8 @@ typedef struct cs_sim_def {
     double dt;                 /* > 0: fixed step; 0: automatic from stability */
     double dt_safety;          /* fraction of the stability limit used (auto) */
     cs_step_limit step_limit;  /* which limit (auto) */
+    double auto_min_gain;      /* auto takes the damped limit when it is at
+                                * least this many times the undamped one */
     int collision_steps;       /* k_i: time steps per outer collision loop */
     double cg_tolerance;       /* m/s, max norm of the velocity residual */
     int cg_max_iterations;

@@ -31,7 +31,7 @@
  * floor: the step never becomes smaller than the default's.
  *
  * The default (time.step_limit: auto) takes the damped limit when the
- * cloth's damping makes it at least AUTO_MIN_GAIN times the undamped one
+ * cloth's damping makes it at least def.auto_min_gain times the undamped one
  * at rest, as Table 1's overdamping does (about 38 times): then a step
  * costs a little more (the bound before each outer step, more CG
  * iterations a solve) and a frame needs a fraction of the steps. Steps far
@@ -54,10 +54,6 @@ enum { LANCZOS_STEPS = 60 };
 enum { STEP_BISECTIONS = 24 };
 /* a step is stable when the bound is at most this */
 static const double STABLE_BOUND = 4;
-/* auto takes the damped limit when it is at least this many times the
- * undamped one at rest: below that its per-step costs (a bound before
- * every outer step, tension that shrinks it in contact) eat the gain */
-static const double AUTO_MIN_GAIN = 4;
 
 typedef double (*step_bound_fn)(cs_sim *sim, double dt);
 
@@ -126,7 +122,7 @@ static bool auto_takes_damped(const cs_sim *sim)
 {
     if (moving_scripts(sim) || sim->def.friction_method != CS_FRICTION_IMPROVED)
         return false;
-    return sim->damped_dt >= AUTO_MIN_GAIN * sim->undamped_dt;
+    return sim->damped_dt >= sim->def.auto_min_gain * sim->undamped_dt;
 }
 
 void cs_step_limit_init(cs_sim *sim)

@@ -133,9 +133,9 @@ static void test_automatic_dt_is_stable_across_resolutions(void **state)
     }
 }
 
-/* A hanging cloth like the one above (8 x 8, pinned at two corners). */
-static cs_sim *hanging_cloth(cs_trimesh **mesh, double dt, double stiffness, char *err,
-                             size_t errlen, int *status)
+/* A hanging cloth like the one above (8 x 8, pinned at two corners): its
+ * definition, the cloth's in static storage. */
+static cs_sim_def hanging_cloth_def(cs_trimesh **mesh, double stiffness)
 {
     double size[2] = {1, 1}, q[4] = {1, 0, 0, 0}, c[3] = {0, 0, 0};
     int res[2] = {8, 8};
@@ -152,6 +152,13 @@ static cs_sim *hanging_cloth(cs_trimesh **mesh, double dt, double stiffness, cha
     def.ncloths = 1;
     def.cloths = &cloth;
     def.fps = 60;
+    return def;
+}
+
+static cs_sim *hanging_cloth(cs_trimesh **mesh, double dt, double stiffness, char *err,
+                             size_t errlen, int *status)
+{
+    cs_sim_def def = hanging_cloth_def(mesh, stiffness);
     def.dt = dt;
     cs_sim *sim = NULL;
     *status = cs_sim_create_checked(&def, &sim, err, errlen);
@@ -166,6 +173,37 @@ static cs_sim *default_hanging_cloth(cs_trimesh **mesh)
     cs_sim *sim = hanging_cloth(mesh, 0, 0, err, sizeof err, &status);
     assert_int_equal(status, CS_OK);
     return sim;
+}
+
+/* step_limit auto takes the damped limit exactly when it is at least
+ * auto_min_gain times the undamped one: gains just under and just over the
+ * cloth's own ratio of the two limits give the two choices. */
+static void test_auto_takes_damped_above_its_gain(void **state)
+{
+    (void)state;
+    cs_trimesh *mesh;
+    cs_sim_def def = hanging_cloth_def(&mesh, 0);
+    cs_sim *sim = cs_sim_create(&def, NULL, 0);
+    assert_non_null(sim);
+    double ratio = cs_sim_damped_dt(sim) / cs_sim_undamped_dt(sim);
+    assert_true(ratio > def.auto_min_gain); /* Table 1's material takes damped */
+    assert_int_equal(cs_sim_step_limit(sim), CS_STEP_DAMPED);
+    cs_sim_destroy(sim);
+    for (int above = 0; above <= 1; above++) {
+        def.auto_min_gain = ratio * (above ? 1.001 : 0.999);
+        sim = cs_sim_create(&def, NULL, 0);
+        assert_non_null(sim);
+        cs_step_limit want = above ? CS_STEP_UNDAMPED : CS_STEP_DAMPED;
+        assert_int_equal(cs_sim_step_limit(sim), want);
+        double limit = above ? cs_sim_undamped_dt(sim) : cs_sim_damped_dt(sim);
+        assert_true(fabs(cs_sim_stable_dt(sim) - limit) <= 1e-12 * limit);
+        cs_sim_destroy(sim);
+    }
+    def.auto_min_gain = 0.5;
+    char err[256] = "";
+    assert_null(cs_sim_create(&def, err, sizeof err));
+    assert_non_null(strstr(err, "auto_min_gain"));
+    cs_trimesh_destroy(mesh);
 }
 
 /* Steps the scene cannot take are refused at creation with the reason, not
@@ -497,6 +535,7 @@ int main(void)
         cmocka_unit_test(test_plan_omits_absent_stages),
         cmocka_unit_test(test_automatic_dt_is_stable_across_resolutions),
         cmocka_unit_test(test_impossible_steps_are_refused),
+        cmocka_unit_test(test_auto_takes_damped_above_its_gain),
         cmocka_unit_test(test_runaway_is_detected_with_its_stage),
         cmocka_unit_test(test_runaway_waits_for_b7_at_contacts),
         cmocka_unit_test(test_runaway_bound_keeps_what_scripts_gave),
