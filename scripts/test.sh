@@ -1,15 +1,21 @@
 #!/bin/sh
 # The test command: installs what is missing, builds with AddressSanitizer and
-# UndefinedBehaviorSanitizer, and runs the whole suite through ctest; then
-# (with no ctest arguments) valgrind's memcheck on a build without
-# sanitizers, for the uninitialised reads ASan cannot see.
+# UndefinedBehaviorSanitizer, and runs the suite through ctest, all but the
+# tests labelled `long` (scripts/test-long.sh runs those); then valgrind's
+# memcheck on a build without sanitizers, for the uninitialised reads ASan
+# cannot see. With arguments, they go to ctest as given (`-R NAME` runs
+# the tests named, long or not) and memcheck is left out.
 set -eu
 cd "$(dirname "$0")/.."
 scripts/install-deps.sh
 cmake -S . -B build-asan -DCMAKE_BUILD_TYPE=Asan >/dev/null
 cmake --build build-asan -j"$(nproc)"
-(cd build-asan && ctest --output-on-failure -j"$(nproc)" "$@")
 if [ "$#" -eq 0 ]; then
+    set -- -LE long
+    memcheck=yes
+fi
+(cd build-asan && ctest --output-on-failure -j"$(nproc)" "$@")
+if [ "${memcheck:-}" = yes ]; then
     cmake -S . -B build-memcheck -DCMAKE_BUILD_TYPE=RelWithDebInfo >/dev/null
     cmake --build build-memcheck -j"$(nproc)" --target clothsim
     sh tests/memcheck.sh "$PWD/build-memcheck/clothsim" "$PWD"
