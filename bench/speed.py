@@ -15,7 +15,7 @@ for the largest case the inner step's cost in ns per spring per step and as
 estimated memory traffic against a STREAM triad measured in the same run.
 
 usage: bench/speed.py [--build DIR] [--repeat N] [--frames N] [--sizes 50,100,200]
-                      [--modes on,off] [--step-limit undamped|damped]
+                      [--modes on,off] [--step-limit auto|undamped|damped]
                       [--pruning speed|path] [--out DIR]
 Writes DIR/speed.csv and DIR/speed.md (default out/speed). Numbers go in
 docs/performance.md by hand, with the machine. A Release build is expected.
@@ -113,8 +113,8 @@ def main():
     ap.add_argument("--frames", type=int, default=48)
     ap.add_argument("--sizes", default="50,100,200")
     ap.add_argument("--modes", default="on,off")
-    ap.add_argument("--step-limit", default="undamped", choices=["undamped", "damped"],
-                    help="time.step_limit for every run (the scene's default is undamped)")
+    ap.add_argument("--step-limit", default="auto", choices=["auto", "undamped", "damped"],
+                    help="time.step_limit for every run (auto, the default, as the scene)")
     ap.add_argument("--pruning", default="speed", choices=["speed", "path"],
                     help="self_collision.pruning for every run (the scene's default is speed)")
     ap.add_argument("--out", default=os.path.join(ROOT, "out", "speed"))
