@@ -9,8 +9,8 @@
 #include "app/exit.h"
 #include "app/export.h"
 #include "app/lock.h"
+#include "app/outdir.h"
 #include "app/run.h"
-#include "app/summary.h"
 #include "import/import.h"
 
 #include <errno.h>

@@ -16,7 +16,6 @@
 #include "app/cli.h"
 #include "app/outdir.h"
 #include "app/run.h"
-#include "app/summary.h"
 #include "app/sweep_cmd.h"
 #include "common/util.h"
 #include "import/import.h"

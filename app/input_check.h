@@ -4,6 +4,8 @@
  * intersections` uses), cloth inside a body, cloth closer than the
  * repulsion thickness to itself or to a body, degenerate triangles and
  * non-manifold edges. docs/input-check.md says what is looked at and how.
+ * The checks are in input_check.c, their listing and the start of `run` in
+ * input_report.c, the `check` command in check_cmd.c (check_cmd.h).
  */
 #ifndef CS_APP_INPUT_CHECK_H
 #define CS_APP_INPUT_CHECK_H
@@ -12,11 +14,6 @@
 #include <stdio.h>
 
 #include "import/import.h"
-
-/* argv[0] is "check"; returns the exit status (0 no error, 1 errors that
- * `run` refuses, 2 bad input, 4 out of memory or a file not written). */
-int cs_check_main(int argc, char **argv);
-void cs_check_help(FILE *out);
 
 /* The start of `run` (rank 0): checks the scene's initial state. An
  * intersecting start (cloth with cloth, or a cloth vertex inside a body) is

@@ -3,10 +3,10 @@
  * Only dispatch lives here, on one table of commands; each command has its
  * own file (run.c, render_cmd.c, ...). A new command, or a help topic
  * (`clothsim help scene`: a row with topic set), is a new row. */
+#include "app/check_cmd.h"
 #include "app/cli.h"
 #include "app/export_cmd.h"
 #include "app/info_cmd.h"
-#include "app/input_check.h"
 #include "app/intersections_cmd.h"
 #include "app/help_cmd.h"
 #include "app/mesh_cmds.h"

@@ -117,4 +117,23 @@ int cs_outdir_save_state(cs_outdir *o, const cs_run_identity *id, int frame,
  * rate. Returns 0, or -1 with err. */
 int cs_outdir_sync(cs_outdir *o, bool now, char *err, size_t errlen);
 
+/* What `clothsim render`, `info`, `export` and `sweep` read back from a run
+ * folder: its summary.json, and its scene.yaml when it has one. */
+typedef struct cs_run_info {
+    char *scene_file;        /* DIR/scene.yaml when DIR has it (its overrides
+                                are in it: none below), else the scene file
+                                the run came from */
+    char *source_file;       /* the scene file the run came from */
+    int noverrides;
+    char **overrides;        /* the run's --set overrides, as given */
+    cs_mesh_format format;
+    int frames_written;
+    double fps;
+} cs_run_info;
+
+/* Reads DIR/summary.json. Returns 0, or an exit status (CS_EXIT_INPUT: no
+ * summary, or not one 'clothsim run' wrote) with err. */
+int cs_run_info_read(const char *dir, cs_run_info *info, char *err, size_t errlen);
+void cs_run_info_free(cs_run_info *info);
+
 #endif

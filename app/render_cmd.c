@@ -1,17 +1,17 @@
-/* render_cmd.c: `clothsim render TARGET`: images of a run's frames (TARGET
- * is its output folder) or of a scene's initial state (TARGET is the scene
- * file), turntables, and animations of the frames (--animation).
+/* render_cmd.c: `clothsim render TARGET`: its command line, the scene
+ * reloaded, and which frames are drawn into which folder, for images of a
+ * run's frames (TARGET is its output folder) or of a scene's initial state
+ * (TARGET is the scene file), turntables, and animations of the frames
+ * (--animation); render_frames.c, render_turntable.c and
+ * render_animation.c draw and assemble them.
  *
  * A run folder holds its resolved scene, DIR/scene.yaml (an older one names
  * its scene file and the --set overrides it ran with in summary.json), so
  * the scene is reloaded exactly: cloth colours, bodies
- * and their motion, the camera. A frame keeps its cloths apart (outdir.h:
- * an object per cloth in OBJ and glTF, a file per cloth in PLY), so each is
- * read back by its name. A frame without them (written before frames kept
- * cloths apart, or the scene's cloths renamed since) is drawn as one mesh
- * in the first cloth's colour, and the command says so once.
+ * and their motion, the camera.
  */
 #include "app/render_cmd.h"
+#include "app/render_cmd_internal.h"
 
 #include "app/cli.h"
 #include "app/outdir.h"
@@ -20,13 +20,9 @@
 #include "common/util.h"
 #include "import/import.h"
 #include "render/render.h"
-#include "sim/sim.h"
 
-#include <cJSON.h>
-#include <dirent.h>
 #include <errno.h>
 #include <getopt.h>
-#include <math.h>
 #include <stdbool.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -34,7 +30,6 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
-#define ERRLEN 8192
 #define MAX_TURNTABLE 360
 
 void cs_render_help(FILE *out)
@@ -95,20 +90,6 @@ static const cs_cli CLI = {
     "                       [--turntable N | --animation] [--set KEY=VALUE]...\n"
     "'clothsim render --help' explains every option.\n",
     NULL, CS_EXIT_USAGE};
-
-typedef struct render_options {
-    const char *target;
-    const char *out_dir;
-    const char *scene_path;
-    const char *frames;
-    cs_render_settings settings;
-    bool samples_given;
-    int turntable;
-    bool animation;
-    int noverrides;
-    char **overrides;
-    bool quiet;
-} render_options;
 
 /* A value cs_parse_size or cs_parse_count refused: 1 not of the form
  * asked for (a bad command line), 2 out of range (bad input). */
@@ -321,334 +302,6 @@ static int parse_frames(const char *list, int n, int **out, int *count, char *er
     return CS_EXIT_OK;
 }
 
-/* ---------------------------------------------------------------- frames */
-
-/* The cloths of one frame, read by name. */
-typedef struct frame_geometry {
-    cs_frame_layout layout;    /* how the run's frames hold the scene's cloths */
-    cs_trimesh **meshes;       /* per cloth: its mesh of the file */
-    cs_trimesh *file;          /* a file without the cloths' objects, merged */
-    const double **x;          /* scene file: per cloth, the scene's positions */
-    cs_frame_cloths cloths;
-} frame_geometry;
-
-static void frame_geometry_clear(frame_geometry *g)
-{
-    cs_trimesh_destroy(g->file);
-    g->file = NULL;
-    for (int c = 0; g->meshes && c < g->layout.ncloths; c++) {
-        cs_trimesh_destroy(g->meshes[c]);
-        g->meshes[c] = NULL;
-    }
-}
-
-/* ------------------------------------------------------------------ main */
-
-typedef struct job {
-    render_options *o;
-    const cs_scene *scene;
-    bool run_mode;
-    cs_run_info info;
-    double fps;
-    char frames_dir[4096];
-    char out_dir[4096];
-    cs_scene_render *sr;
-    cs_image *image;
-    frame_geometry geom;
-    bool merged_said;
-} job;
-
-/* Loads the geometry of frame f into j->geom: per cloth its object of the
- * frame, read by name; a file without them (an older run's, or a scene
- * changed since) is drawn as one mesh in the first cloth's colour, as the
- * command says once. */
-static int get_frame(job *j, int f, char *err, size_t errlen)
-{
-    frame_geometry *g = &j->geom;
-    frame_geometry_clear(g);
-    if (!j->run_mode) {
-        for (int c = 0; c < j->scene->def.ncloths; c++)
-            g->x[c] = j->scene->def.cloths[c].mesh->x;
-        g->cloths = (cs_frame_cloths){.x = g->x};
-        return CS_EXIT_OK;
-    }
-    int status = cs_frame_read(&g->layout, j->frames_dir, f, g->meshes, err, errlen);
-    g->cloths = (cs_frame_cloths){.meshes = (const cs_trimesh *const *)g->meshes};
-    if (status != CS_EXIT_INPUT || g->layout.format == CS_MESH_PLY)
-        return status;
-    char path[4096], why[ERRLEN];
-    cs_frame_file_path(&g->layout, j->frames_dir, f, 0, path, sizeof path);
-    snprintf(why, sizeof why, "%s", err);
-    if (access(path, F_OK) != 0 || !(g->file = cs_mesh_read(path, err, errlen)))
-        return CS_EXIT_INPUT;
-    g->cloths = (cs_frame_cloths){.merged = g->file};
-    if (!j->merged_said && !j->o->quiet)
-        fprintf(stderr, "clothsim render: %s: all cloth is drawn as one mesh in the first "
-                        "cloth's colour\n", why);
-    j->merged_said = true;
-    return CS_EXIT_OK;
-}
-
-static int render_frames(job *j, const int *frames, int nframes)
-{
-    char err[ERRLEN];
-    for (int k = 0; k < nframes; k++) {
-        int f = frames[k];
-        int status = get_frame(j, f, err, sizeof err);
-        cs_render_stats st;
-        if (status == CS_EXIT_OK)
-            status = cs_scene_render_draw(j->sr, f / j->fps, &j->geom.cloths, NULL, j->image, &st,
-                                          err, sizeof err);
-        if (status != CS_EXIT_OK) {
-            fprintf(stderr, "clothsim render: frame %d: %s\n", f, err);
-            return status;
-        }
-        char path[4200];
-        cs_frame_path(path, sizeof path, j->out_dir, f, NULL, "png");
-        if (cs_image_write_png(j->image, path, err, sizeof err) != CS_OK) {
-            fprintf(stderr, "clothsim render: %s\n", err);
-            return CS_EXIT_OUTPUT;
-        }
-        if (!j->o->quiet)
-            printf("frame %d: %s (%.2f s)\n", f, path, st.seconds);
-    }
-    if (!j->o->quiet)
-        printf("rendered %d image%s into %s\n", nframes, nframes == 1 ? "" : "s", j->out_dir);
-    return CS_EXIT_OK;
-}
-
-/* ------------------------------------------------------------ animations */
-
-/* dir/leaf as an ffmpeg image pattern: a '%' of dir doubled, leaf (which
- * holds the number's conversion) as it is. 0, or -1 when it does not fit. */
-static int image_pattern(const char *dir, const char *leaf, char *out, size_t len)
-{
-    size_t k = 0;
-    bool fits = true;
-    for (const char *s = dir; *s && fits; s++) {
-        fits = k + 3 < len;
-        if (fits && *s == '%')
-            out[k++] = '%';
-        if (fits)
-            out[k++] = *s;
-    }
-    int n = fits ? snprintf(out + k, len - k, "/%s", leaf) : -1;
-    if (n < 0 || (size_t)n >= len - k) {
-        fprintf(stderr, "clothsim render: the folder name %s is too long for ffmpeg\n", dir);
-        return -1;
-    }
-    return 0;
-}
-
-/* The one way turntables and --animation make an animation: the PNGs that
- * pattern numbers first .. first + count - 1, at fps, become DIR/BASE.mp4
- * and DIR/BASE.gif through the ffmpeg program (cs_render_animation); the
- * files of an earlier animation of that name go first. *made is false when
- * ffmpeg is not installed. Returns 0, or CS_EXIT_OUTPUT when ffmpeg failed
- * (its message and ours said; the PNGs stay). */
-static int make_animation(const job *j, const char *pattern, int first, int count, double fps,
-                          const char *base, bool *made)
-{
-    static const char *const exts[] = {"mp4", "gif"};
-    *made = false;
-    for (int e = 0; e < 2; e++) {
-        char path[4300];
-        snprintf(path, sizeof path, "%s/%s.%s", j->out_dir, base, exts[e]);
-        if (unlink(path) != 0 && errno != ENOENT) {
-            fprintf(stderr, "clothsim render: cannot remove the old %s: %s\n", path,
-                    strerror(errno));
-            return CS_EXIT_OUTPUT;
-        }
-    }
-    for (int e = 0; e < 2; e++) {
-        char path[4300], err[ERRLEN];
-        snprintf(path, sizeof path, "%s/%s.%s", j->out_dir, base, exts[e]);
-        int rc = cs_render_animation(pattern, first, count, fps, path, err, sizeof err);
-        if (rc == 0)
-            return CS_EXIT_OK;
-        if (rc < 0) {
-            fprintf(stderr, "clothsim render: %s; the images are kept in %s\n", err,
-                    j->out_dir);
-            return CS_EXIT_OUTPUT;
-        }
-        *made = true;
-        if (!j->o->quiet)
-            printf("animation: %s\n", path);
-    }
-    return CS_EXIT_OK;
-}
-
-/* Links DIR/frame_NNNN.png of the listed frames as TMPDIR/000000.png, ... in
- * their order (a hard link, else a symbolic one): what ffmpeg's numbered
- * input needs when the frames are not consecutive. Returns how many were
- * linked (all on success); the caller removes them. */
-static int link_frames(const char *dir, const char *tmpdir, const int *frames, int nframes)
-{
-    for (int k = 0; k < nframes; k++) {
-        char from[4200], to[4200], rel[64];
-        cs_frame_path(from, sizeof from, dir, frames[k], NULL, "png");
-        snprintf(to, sizeof to, "%s/%06d.png", tmpdir, k);
-        cs_frame_path(rel, sizeof rel, "..", frames[k], NULL, "png");
-        if (link(from, to) != 0 && symlink(rel, to) != 0) {
-            fprintf(stderr, "clothsim render: cannot link %s as %s: %s\n", from, to,
-                    strerror(errno));
-            return k;
-        }
-    }
-    return nframes;
-}
-
-/* --animation: the frames just rendered, in the order listed, at the run's
- * frames per second. */
-static int render_animation(job *j, const int *frames, int nframes)
-{
-    bool consecutive = true;
-    for (int k = 1; k < nframes; k++)
-        consecutive = consecutive && frames[k] == frames[0] + k;
-    char pattern[8800], tmpdir[4300] = "";
-    int status = CS_EXIT_OK, linked = 0;
-    bool made = false;
-    if (consecutive) {
-        if (image_pattern(j->out_dir, "frame_%04d.png", pattern, sizeof pattern) != 0)
-            status = CS_EXIT_OUTPUT;
-        else
-            status = make_animation(j, pattern, frames[0], nframes, j->fps, "animation", &made);
-    } else {
-        snprintf(tmpdir, sizeof tmpdir, "%s/.animation.XXXXXX", j->out_dir);
-        if (!mkdtemp(tmpdir)) {
-            fprintf(stderr, "clothsim render: cannot create %s: %s\n", tmpdir, strerror(errno));
-            return CS_EXIT_OUTPUT;
-        }
-        linked = link_frames(j->out_dir, tmpdir, frames, nframes);
-        if (linked < nframes)
-            status = CS_EXIT_OUTPUT;
-        else if (image_pattern(tmpdir, "%06d.png", pattern, sizeof pattern) != 0)
-            status = CS_EXIT_OUTPUT;
-        else
-            status = make_animation(j, pattern, 0, nframes, j->fps, "animation", &made);
-        for (int k = 0; k < linked; k++) {
-            char path[4400];
-            snprintf(path, sizeof path, "%s/%06d.png", tmpdir, k);
-            unlink(path);
-        }
-        rmdir(tmpdir);
-    }
-    if (status == CS_EXIT_OK && !made)
-        fprintf(stderr, "clothsim render: no animation: ffmpeg is not installed (not on the "
-                        "PATH); the %d PNG frame%s %s in %s\n", nframes,
-                nframes == 1 ? "" : "s", nframes == 1 ? "is" : "are", j->out_dir);
-    return status;
-}
-
-/* view_<digits>.png of an earlier turntable would join this one's animation. */
-static int remove_old_views(const char *dir)
-{
-    DIR *d = opendir(dir);
-    if (!d)
-        return 0;
-    int rc = 0;
-    struct dirent *e;
-    while ((e = readdir(d)) != NULL) {
-        const char *s = e->d_name;
-        if (strncmp(s, "view_", 5) != 0 || s[5] < '0' || s[5] > '9')
-            continue;
-        s += 5;
-        while (*s >= '0' && *s <= '9')
-            s++;
-        if (strcmp(s, ".png") != 0)
-            continue;
-        char path[4400];
-        snprintf(path, sizeof path, "%s/%s", dir, e->d_name);
-        if (unlink(path) != 0) {
-            fprintf(stderr, "clothsim render: cannot remove the old view %s: %s\n", path,
-                    strerror(errno));
-            rc = -1;
-            break;
-        }
-    }
-    closedir(d);
-    return rc;
-}
-
-static int render_turntable(job *j, int f)
-{
-    char err[ERRLEN];
-    int n = j->o->turntable;
-    if (remove_old_views(j->out_dir) != 0)
-        return CS_EXIT_OUTPUT;
-    int status = get_frame(j, f, err, sizeof err);
-    if (status != CS_EXIT_OK) {
-        fprintf(stderr, "clothsim render: frame %d: %s\n", f, err);
-        return status;
-    }
-    double t = f / j->fps, centre[3];
-    cs_scene_render_centre(j->sr, t, &j->geom.cloths, centre);
-    cs_render_camera cam = cs_scene_render_camera(j->sr, t);
-    int thumb = j->image->width < 200 ? j->image->width : 200;
-    cs_image **thumbs = calloc((size_t)n, sizeof *thumbs);
-    char (*labels)[48] = calloc((size_t)n, sizeof *labels);
-    const char **label_ptrs = calloc((size_t)n, sizeof *label_ptrs);
-    if (!thumbs || !labels || !label_ptrs) {
-        fprintf(stderr, "clothsim render: out of memory\n");
-        status = CS_EXIT_OUTPUT;
-    }
-    for (int k = 0; k < n && status == CS_EXIT_OK; k++) {
-        double angle = 2 * M_PI * k / n;
-        cs_render_camera view =
-            cs_render_camera_orbit(&cam, centre, cs_scene_render_up(j->sr), angle);
-        cs_render_stats st;
-        status = cs_scene_render_draw(j->sr, t, &j->geom.cloths, &view, j->image, &st, err,
-                                      sizeof err);
-        if (status != CS_EXIT_OK) {
-            fprintf(stderr, "clothsim render: frame %d, view %d: %s\n", f, k, err);
-            break;
-        }
-        char path[4200];
-        snprintf(path, sizeof path, "%s/view_%03d.png", j->out_dir, k);
-        if (cs_image_write_png(j->image, path, err, sizeof err) != CS_OK) {
-            fprintf(stderr, "clothsim render: %s\n", err);
-            status = CS_EXIT_OUTPUT;
-            break;
-        }
-        if (!(thumbs[k] = cs_image_shrink(j->image, thumb))) {
-            fprintf(stderr, "clothsim render: out of memory\n");
-            status = CS_EXIT_OUTPUT;
-            break;
-        }
-        snprintf(labels[k], sizeof labels[k], "frame %d, %.0f\u00b0", f, angle * 180 / M_PI);
-        label_ptrs[k] = labels[k];
-        if (!j->o->quiet)
-            printf("view %d: %s (%.2f s)\n", k, path, st.seconds);
-    }
-    if (status == CS_EXIT_OK) {
-        char path[4200];
-        snprintf(path, sizeof path, "%s/contact_sheet.png", j->out_dir);
-        int cols = n <= 4 ? n : n <= 8 ? 4 : (int)ceil(sqrt((double)n));
-        if (cs_render_contact_sheet(path, n, (const cs_image *const *)thumbs, label_ptrs, cols,
-                                    thumb, err, sizeof err) != CS_OK) {
-            fprintf(stderr, "clothsim render: %s\n", err);
-            status = CS_EXIT_OUTPUT;
-        } else if (!j->o->quiet) {
-            printf("contact sheet: %s\n", path);
-        }
-    }
-    if (status == CS_EXIT_OK && n > 1) {
-        /* Only if ffmpeg is installed; without it the sheet is the result. */
-        char pattern[8800];
-        bool made;
-        if (image_pattern(j->out_dir, "view_%03d.png", pattern, sizeof pattern) != 0)
-            status = CS_EXIT_OUTPUT;
-        else
-            status = make_animation(j, pattern, 0, n, 12.0, "turntable", &made);
-    }
-    for (int k = 0; thumbs && k < n; k++)
-        cs_image_destroy(thumbs[k]);
-    free(thumbs);
-    free(labels);
-    free(label_ptrs);
-    return status;
-}
-
 int cs_render_main(int argc, char **argv)
 {
     render_options o;
@@ -657,7 +310,7 @@ int cs_render_main(int argc, char **argv)
         free(o.overrides);
         return status;
     }
-    job j;
+    render_job j;
     memset(&j, 0, sizeof j);
     j.o = &o;
     cs_scene *scene = NULL;
@@ -778,12 +431,13 @@ int cs_render_main(int argc, char **argv)
         status = CS_EXIT_OUTPUT;
         goto done;
     }
-    status = o.turntable ? render_turntable(&j, frames[0]) : render_frames(&j, frames, nframes);
+    status = o.turntable ? cs_render_cmd_turntable(&j, frames[0])
+                         : cs_render_cmd_frames(&j, frames, nframes);
     if (status == CS_EXIT_OK && o.animation)
-        status = render_animation(&j, frames, nframes);
+        status = cs_render_cmd_animation(&j, frames, nframes);
 
 done:
-    frame_geometry_clear(&j.geom);
+    cs_frame_geometry_clear(&j.geom);
     cs_frame_layout_free(&j.geom.layout);
     free(j.geom.meshes);
     free(j.geom.x);

@@ -2,9 +2,6 @@
  * `clothsim run`. */
 #include "app/summary.h"
 
-#include "app/outdir.h"
-
-#include "app/run.h"
 #include "common/util.h"
 
 #include <cJSON.h>
@@ -463,96 +460,4 @@ void cs_summary_print_table(const cs_summary *s, FILE *out)
     } else {
         fprintf(out, "no frame simulated\n");
     }
-}
-
-/* ------------------------------------------------------------ reading */
-
-void cs_run_info_free(cs_run_info *r)
-{
-    free(r->scene_file);
-    free(r->source_file);
-    for (int i = 0; i < r->noverrides; i++)
-        free(r->overrides[i]);
-    free(r->overrides);
-    memset(r, 0, sizeof *r);
-}
-
-/* The overrides of a summary (an array of strings) into info. */
-static int read_overrides(const cJSON *over, const char *path, cs_run_info *info, char *err,
-                          size_t errlen)
-{
-    int n = over ? cJSON_GetArraySize(over) : 0;
-    info->overrides = calloc((size_t)n + 1, sizeof *info->overrides);
-    if (!info->overrides)
-        goto nomem;
-    const cJSON *item;
-    if (over)
-        cJSON_ArrayForEach(item, over) {
-            if (!cJSON_IsString(item)) {
-                snprintf(err, errlen, "%s: \"overrides\" must be a list of strings", path);
-                return CS_EXIT_INPUT;
-            }
-            if (!(info->overrides[info->noverrides] = strdup(item->valuestring)))
-                goto nomem;
-            info->noverrides++;
-        }
-    return CS_EXIT_OK;
-nomem:
-    snprintf(err, errlen, "out of memory");
-    return CS_EXIT_OUTPUT;
-}
-
-int cs_run_info_read(const char *dir, cs_run_info *info, char *err, size_t errlen)
-{
-    memset(info, 0, sizeof *info);
-    char path[4096];
-    snprintf(path, sizeof path, "%s/summary.json", dir);
-    if (access(path, F_OK) != 0) {
-        snprintf(err, errlen,
-                 "%s has no summary.json: give the output folder of 'clothsim run' or a "
-                 "scene file",
-                 dir);
-        return CS_EXIT_INPUT;
-    }
-    size_t len;
-    char *text = cs_file_read_all(path, &len);
-    if (!text) {
-        snprintf(err, errlen, "cannot read %s: %s", path, strerror(errno));
-        return CS_EXIT_INPUT;
-    }
-    cJSON *root = cJSON_Parse(text);
-    free(text);
-    const cJSON *scene = cJSON_GetObjectItemCaseSensitive(root, "scene_file");
-    const cJSON *format = cJSON_GetObjectItemCaseSensitive(root, "format");
-    const cJSON *written = cJSON_GetObjectItemCaseSensitive(root, "frames_written");
-    const cJSON *fps = cJSON_GetObjectItemCaseSensitive(root, "fps");
-    const cJSON *over = cJSON_GetObjectItemCaseSensitive(root, "overrides");
-    if (!cJSON_IsString(scene) || !cJSON_IsString(format) || !cJSON_IsNumber(written) ||
-        !cJSON_IsNumber(fps) || !cs_mesh_format_from_name(format->valuestring, &info->format) ||
-        (over && !cJSON_IsArray(over))) {
-        snprintf(err, errlen,
-                 "%s: not a summary written by 'clothsim run' (needs scene_file, format, "
-                 "frames_written, fps)",
-                 path);
-        cJSON_Delete(root);
-        return CS_EXIT_INPUT;
-    }
-    info->frames_written = written->valuedouble > 0 && written->valuedouble < 1e8
-                               ? (int)written->valuedouble
-                               : 0;
-    info->fps = fps->valuedouble;
-    /* a folder with its resolved scene needs neither the file the run
-     * came from nor its overrides, which that scene holds */
-    char *resolved = cs_outdir_scene(dir);
-    int status = resolved ? CS_EXIT_OK : read_overrides(over, path, info, err, errlen);
-    info->scene_file = resolved;
-    info->source_file = strdup(scene->valuestring);
-    if (status == CS_EXIT_OK && !resolved && info->source_file)
-        info->scene_file = strdup(info->source_file);
-    if (status == CS_EXIT_OK && (!info->source_file || !info->scene_file)) {
-        snprintf(err, errlen, "out of memory");
-        status = CS_EXIT_OUTPUT;
-    }
-    cJSON_Delete(root);
-    return status;
 }

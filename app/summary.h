@@ -131,22 +131,4 @@ int cs_summary_write(const cs_summary *s, const char *path, bool final, char *er
 /* The stage table: per planned stage seconds, share %, calls; then totals. */
 void cs_summary_print_table(const cs_summary *s, FILE *out);
 
-/* What `clothsim render` reads back from a run's summary.json. */
-typedef struct cs_run_info {
-    char *scene_file;        /* DIR/scene.yaml when DIR has it (its overrides
-                                are in it: none below), else the scene file
-                                the run came from */
-    char *source_file;       /* the scene file the run came from */
-    int noverrides;
-    char **overrides;        /* the run's --set overrides, as given */
-    cs_mesh_format format;
-    int frames_written;
-    double fps;
-} cs_run_info;
-
-/* Reads DIR/summary.json. Returns 0, or an exit status (CS_EXIT_INPUT: no
- * summary, or not one 'clothsim run' wrote) with err. */
-int cs_run_info_read(const char *dir, cs_run_info *info, char *err, size_t errlen);
-void cs_run_info_free(cs_run_info *info);
-
 #endif

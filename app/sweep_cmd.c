@@ -17,7 +17,6 @@
 #include "app/outdir.h"
 #include "app/progress.h"
 #include "app/run.h"
-#include "app/summary.h"
 #include "app/sweep_metrics.h"
 #include "common/util.h"
 #include "import/import.h"

@@ -9,7 +9,8 @@
  *   3. --set overrides: each value is parsed into the document, from where
  *      it goes into the raw structs through its key's row (scene_set.c);
  *   4. the raw structs become a cs_scene (scene_convert.c, scene_cloth.c,
- *      scene_mesh.c), each value checked once against its key's range;
+ *      scene_mesh.c, each calling only the ones after it), each value
+ *      checked once against its key's range (scene_values.c);
  *   5. mesh bodies get their level sets (scene_mesh.c);
  *   6. the resolved scene is written back as YAML (scene_emit.c).
  * The document stays alive to the end so that every message can be placed.
@@ -80,7 +81,7 @@ int cs_sl_apply_override(loader *L, cs_raw_scene *raw, const cs_spath *p);
  * p: raw's path, given back as it came. */
 int cs_sl_check_required(loader *L, int sec, const void *raw, cs_spath *p);
 
-/* ------------------------------------------------ scene_convert.c */
+/* ------------------------------------------------ scene_values.c */
 
 /* Values of keys (scene_keys.def) under base ("" at the top level), checked
  * against the key's range; an absent one gets the key's default (for a
@@ -108,6 +109,8 @@ bool cs_sl_note(cs_scene *s, const char *fmt, ...) __attribute__((format(printf,
 /* The folder of the scene file, to which its paths are relative. */
 char *cs_sl_scene_dir(const char *file);
 const char *cs_sl_base_name(const char *path);
+
+/* ------------------------------------------------ scene_convert.c */
 
 int cs_sl_convert_scene(loader *L, const cs_raw_scene *r, const char *default_name,
                         cs_scene **out);
