@@ -187,16 +187,3 @@ bool cs_runaway_end_step(cs_sim *sim, int not_finite)
     sim->runaway.speed = verdict[1];
     return false;
 }
-
-bool cs_sim_runaway(const cs_sim *sim, const char **stage, double *speed, double *limit)
-{
-    if (sim->runaway.stage < 0)
-        return false;
-    if (stage)
-        *stage = cs_stage_name((cs_stage)sim->runaway.stage);
-    if (speed)
-        *speed = sim->runaway.speed;
-    if (limit)
-        *limit = sim->runaway.limit;
-    return true;
-}

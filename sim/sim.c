@@ -530,6 +530,20 @@ const cs_comm_stats *cs_sim_stage_comm(const cs_sim *sim)
 {
     return sim->par->size > 1 ? sim->comm_all : sim->par->stats;
 }
+/* here, not in runaway.c: the stage's name is the stage table's, which
+ * lies above the checks */
+bool cs_sim_runaway(const cs_sim *sim, const char **stage, double *speed, double *limit)
+{
+    if (sim->runaway.stage < 0)
+        return false;
+    if (stage)
+        *stage = cs_stage_name((cs_stage)sim->runaway.stage);
+    if (speed)
+        *speed = sim->runaway.speed;
+    if (limit)
+        *limit = sim->runaway.limit;
+    return true;
+}
 int cs_sim_agree(cs_sim *sim, int value) { return cs_par_bcast_int(sim->par, value); }
 int cs_sim_rank(const cs_sim *sim) { return sim->par->rank; }
 int cs_sim_ranks(const cs_sim *sim) { return sim->par->size; }
