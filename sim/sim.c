@@ -484,27 +484,6 @@ void cs_sim_destroy(cs_sim *sim)
     free(sim);
 }
 
-long cs_sim_count_intersections(const cs_sim *sim)
-{
-    /* every cloth's triangles in global particle indices, as one mesh */
-    long nt = 0;
-    for (int c = 0; c < sim->ncloths; c++)
-        nt += sim->cloths[c].mesh->nt;
-    int *tri = malloc(sizeof *tri * 3 * (size_t)(nt + 1));
-    if (!tri)
-        return -1;
-    long t = 0;
-    for (int c = 0; c < sim->ncloths; c++) {
-        const cs_trimesh *m = sim->cloths[c].mesh;
-        for (int k = 0; k < 3 * m->nt; k++)
-            tri[3 * t + k] = sim->cloths[c].offset + m->tri[k];
-        t += m->nt;
-    }
-    long count = cs_count_intersections(sim->n, sim->x, (int)nt, tri);
-    free(tri);
-    return count;
-}
-
 double cs_sim_time(const cs_sim *sim) { return sim->t; }
 double cs_sim_dt(const cs_sim *sim) { return sim->dt; }
 double cs_sim_stable_dt(const cs_sim *sim) { return sim->stable_dt; }
