@@ -1,5 +1,6 @@
 /* sim.c: the definitions' defaults, creating and destroying the
- * simulation, and its accessors. The step is in step.c, frames in frame.c. */
+ * simulation, and its accessors. The stage table and the loops that run a
+ * step and a frame are in stages.c, the stages' work in step.c and frame.c. */
 #include <math.h>
 #include <stdarg.h>
 #include <stdio.h>

@@ -1,6 +1,7 @@
 /* stages.h: the rows of the stage table (stages.c) and what they run
  * with, private to sim/. A row's work lives with its kind: a time step's
- * stages in step.c, the outer step's and the frame's in frame.c. */
+ * stages in step.c, the outer step's and the frame's in frame.c; the
+ * loops that run a step, an outer step and a frame are stages.c's. */
 #ifndef CS_STAGES_H
 #define CS_STAGES_H
 
