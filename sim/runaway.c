@@ -25,6 +25,7 @@
  * Each stage that produces a velocity checks its result on the owned free
  * particles (no message); the end of the step's reduction, which every step
  * already makes for NaN, carries the verdict and the first stage. */
+#include "sim/body_grid.h"
 #include "sim/internal.h"
 #include "sim/vec3.h"
 
