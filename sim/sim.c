@@ -9,6 +9,7 @@
 #include <time.h>
 
 #include "sim/internal.h"
+#include "sim/stages.h"
 #include "common/util.h"
 #include "sim/vec3.h"
 

@@ -364,9 +364,6 @@ typedef struct cs_plan {
     cs_stage stages[CS_STAGE_COUNT];
 } cs_plan;
 
-/* What the scene definition calls for, without creating anything: its
- * stages in the order they run. */
-cs_plan cs_plan_from_def(const cs_sim_def *def);
 /* Inline: the stages ask it, and plan.c, which reads the stage table,
  * lies above them. */
 static inline bool cs_plan_has(const cs_plan *plan, cs_stage stage)
@@ -551,10 +548,6 @@ long cs_count_intersections(int nv, const double *x, int nt, const int *tri);
  * in increasing order, pair k as triangles pairs[2k] < pairs[2k + 1]. */
 long cs_find_intersections(int nv, const double *x, int nt, const int *tri, int maxpairs,
                            int *pairs);
-
-/* The exact narrow phase alone: whether the closed triangles p and q
- * (3 vertices of 3 doubles each, possibly degenerate) intersect. */
-bool cs_triangles_intersect(const double p[9], const double q[9]);
 
 /* ------------------------------------------- state for resuming (checkpoint.c) */
 

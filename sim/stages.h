@@ -67,6 +67,10 @@ typedef struct cs_stage_row {
 const cs_stage_row *cs_stage_rows(void);
 bool cs_stage_need_met(cs_stage_need need, const cs_sim_def *def);
 
+/* plan.c: what the scene definition calls for, without creating anything:
+ * its stages in the order they run. */
+cs_plan cs_plan_from_def(const cs_sim_def *def);
+
 /* Runs the planned rows of a phase in order, each timed, counted and its
  * velocity checked in this one place; stops at the first failure (but for
  * rows that run after one). Returns ctx->status. */
