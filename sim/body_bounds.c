@@ -2,7 +2,7 @@
  * occupancy (body_grid.c). A box must hold every point where the body's
  * phi < offset (where it collides); planes, and distance functions without
  * a box, are unbounded. */
-#include "sim/sim.h"
+#include "sim/body_grid.h"
 #include "sim/vec3.h"
 
 bool cs_body_def_bounds(const cs_body_def *b, double t, double lo[3], double hi[3])

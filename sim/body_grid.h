@@ -28,6 +28,11 @@ typedef struct cs_body_grid {
     int *points;
 } cs_body_grid;
 
+/* body_bounds.c: a world box at time t holding every point where the
+ * body's phi < offset (the region where it collides). False for an
+ * unbounded body (a plane, or phi_fn without phi_bounded). */
+bool cs_body_def_bounds(const cs_body_def *b, double t, double lo[3], double hi[3]);
+
 /* Builds the partition for the bodies at time t and points x (3 per point);
  * only points with is_free[i] are listed. With x NULL, only the cells (for
  * cs_body_grid_cell_bodies): no point is listed. */

@@ -22,6 +22,11 @@ void cs_body_def_pose(const cs_body_def *b, double t, cs_body_pose *pose);
 double cs_body_posed_phi(const cs_body_def *b, const cs_body_pose *pose, const double x[3],
                          double grad[3]);
 void cs_body_posed_velocity(const cs_body_pose *pose, const double x[3], double v[3]);
+/* The body's Coulomb coefficient at time t: `friction`, or its schedule
+ * evaluated at t (see cs_body_def.friction_keys). */
+double cs_body_def_friction(const cs_body_def *b, double t);
+/* Velocity at time t of the body material point at world position x. */
+void cs_body_def_velocity(const cs_body_def *b, double t, const double x[3], double v[3]);
 
 /* What the solver may change about a particle's velocity. */
 enum { CS_FIXED = 0, CS_FREE = 1, CS_CONTACT = 2 };
@@ -221,6 +226,10 @@ void cs_scripts_hold_releasable(cs_sim *sim, bool hold);
 /* wind.c: area-weighted vertex normals and a third of the adjacent area
  * at positions x (wind_normal, wind_area), for the drag */
 void cs_wind_geometry(cs_sim *sim, const double *x);
+/* The wind at point p and time t (the +y axis is up in every scene). */
+void cs_wind_at(const cs_wind_def *w, const double p[3], double t, double out[3]);
+/* The fastest wind cs_wind_at can give anywhere, at any time. */
+double cs_wind_max_speed(const cs_wind_def *w);
 
 /* contact.c: Section 6. */
 void cs_gamma(const double v[3], const double N[3], const double vb[3], double mu,

@@ -12,14 +12,6 @@ cs_plan cs_plan_from_def(const cs_sim_def *def)
     return plan;
 }
 
-bool cs_plan_has(const cs_plan *plan, cs_stage stage)
-{
-    for (int i = 0; i < plan->nstages; i++)
-        if (plan->stages[i] == stage)
-            return true;
-    return false;
-}
-
 /* Peak resident bytes per particle of a run, measured on the sheet-and-ball
  * benchmark (Release, one thread, first frame; the difference between 60 x 60
  * and 120 x 120 quads), with self-collision (BVH, pairs, history, impact

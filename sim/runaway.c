@@ -25,6 +25,7 @@
  * Each stage that produces a velocity checks its result on the owned free
  * particles (no message); the end of the step's reduction, which every step
  * already makes for NaN, carries the verdict and the first stage. */
+#include "sim/body_grid.h"
 #include "sim/internal.h"
 #include "sim/vec3.h"
 
@@ -186,17 +187,4 @@ bool cs_runaway_end_step(cs_sim *sim, int not_finite)
     sim->runaway.stage = CS_STAGE_COUNT - (int)verdict[0];
     sim->runaway.speed = verdict[1];
     return false;
-}
-
-bool cs_sim_runaway(const cs_sim *sim, const char **stage, double *speed, double *limit)
-{
-    if (sim->runaway.stage < 0)
-        return false;
-    if (stage)
-        *stage = cs_stage_name((cs_stage)sim->runaway.stage);
-    if (speed)
-        *speed = sim->runaway.speed;
-    if (limit)
-        *limit = sim->runaway.limit;
-    return true;
 }

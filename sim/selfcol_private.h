@@ -1,5 +1,5 @@
-/* selfcol_private.h: what step C (selfcol_collide.c) shares with the
- * rest of the self-collision code (selfcol.c); private to those two. */
+/* selfcol_private.h: what the self-collision files (sim/selfcol*.c) share
+ * among themselves, by the file that defines it; private to them. */
 #ifndef CS_SELFCOL_PRIVATE_H
 #define CS_SELFCOL_PRIVATE_H
 
@@ -17,8 +17,25 @@ typedef struct response {
     double thickness, k, mu, epsilon;
 } response;
 
+/* ---- selfcol_pairs.c: pair lists, union-find, pairs' ranks (Section 7) */
 int sc_pair_push(cs_pair_list *l, const int v[4], const double *s0);
+int sc_zone_find(int *parent, int i);
+void sc_zone_union(int *parent, int a, int b);
+int sc_pair_rank(const cs_par *par, const int v[4]);
 int sc_distribute_boundary(cs_sim *sim, cs_pair_list *pt, cs_pair_list *ee);
+
+/* ---- selfcol_response.c: one pair's frame and response */
+void sc_pair_impulse(const cs_selfcol *sc, const cs_pair *p, const double c[4], double J,
+                     const double dir[3], double *v);
+double sc_pair_inverse_mass(const cs_selfcol *sc, const cs_pair *p, const double c[4]);
+double sc_pair_normal_velocity(const cs_pair *p, const double c[4], const double *v,
+                               const double n[3], double rel[3]);
+bool sc_pair_respond(const cs_selfcol *sc, const cs_pair *p, bool is_edge, const double *x,
+                     double *v, const response *r);
+double sc_ring_side(const cs_selfcol *sc, const double *x, int point, const double nrm[3]);
+bool sc_sides_apart(const double *const p[4], int split, double gap);
+
+/* ---- selfcol_cache.c: the candidate pairs kept between searches */
 /* Before steps A and C search with the boxes in sc->pbox, ebox and tbox
  * (around x_free): makes the cache hold every pair whose boxes can overlap,
  * traversing the trees only when a particle's box left its grown box;
@@ -41,17 +58,8 @@ typedef struct sc_skin {
  * at any thread count. Returns 0 or -1. */
 int sc_find_pairs(cs_selfcol *sc, bool edges, bool only_dirty, const sc_skin *skin,
                   pair_maker make, const void *ctx, cs_pair_list *list);
-void sc_pair_impulse(const cs_selfcol *sc, const cs_pair *p, const double c[4], double J,
-                     const double dir[3], double *v);
-double sc_pair_inverse_mass(const cs_selfcol *sc, const cs_pair *p, const double c[4]);
-double sc_pair_normal_velocity(const cs_pair *p, const double c[4], const double *v,
-                               const double n[3], double rel[3]);
-int sc_pair_rank(const cs_par *par, const int v[4]);
-bool sc_pair_respond(const cs_selfcol *sc, const cs_pair *p, bool is_edge, const double *x,
-                     double *v, const response *r);
-double sc_ring_side(const cs_selfcol *sc, const double *x, int point, const double nrm[3]);
-bool sc_sides_apart(const double *const p[4], int split, double gap);
-int sc_zone_find(int *parent, int i);
+
+/* ---- selfcol_project.c: zones across prescribed motions */
 /* Keeps a collision found in a zone pass (weights c, normal n oriented from
  * the side it started on) as a constraint for sc_project_zone. Returns 0
  * or -1 (no memory). */
@@ -62,6 +70,5 @@ int sc_zone_constraint_add(cs_selfcol *sc, const int v[4], const double c[4], co
  * Returns false, with where and how short in why, when no end state was
  * found. */
 bool sc_project_zone(cs_selfcol *sc, int root, double *x, cs_script_conflict *why);
-void sc_zone_union(int *parent, int a, int b);
 
 #endif

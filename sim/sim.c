@@ -1,5 +1,6 @@
 /* sim.c: the definitions' defaults, creating and destroying the
- * simulation, and its accessors. The step is in step.c, frames in frame.c. */
+ * simulation, and its accessors. The stage table and the loops that run a
+ * step and a frame are in stages.c, the stages' work in step.c and frame.c. */
 #include <math.h>
 #include <stdarg.h>
 #include <stdio.h>
@@ -8,6 +9,7 @@
 #include <time.h>
 
 #include "sim/internal.h"
+#include "sim/stages.h"
 #include "common/util.h"
 #include "sim/vec3.h"
 
@@ -489,27 +491,6 @@ void cs_sim_destroy(cs_sim *sim)
     free(sim);
 }
 
-long cs_sim_count_intersections(const cs_sim *sim)
-{
-    /* every cloth's triangles in global particle indices, as one mesh */
-    long nt = 0;
-    for (int c = 0; c < sim->ncloths; c++)
-        nt += sim->cloths[c].mesh->nt;
-    int *tri = malloc(sizeof *tri * 3 * (size_t)(nt + 1));
-    if (!tri)
-        return -1;
-    long t = 0;
-    for (int c = 0; c < sim->ncloths; c++) {
-        const cs_trimesh *m = sim->cloths[c].mesh;
-        for (int k = 0; k < 3 * m->nt; k++)
-            tri[3 * t + k] = sim->cloths[c].offset + m->tri[k];
-        t += m->nt;
-    }
-    long count = cs_count_intersections(sim->n, sim->x, (int)nt, tri);
-    free(tri);
-    return count;
-}
-
 double cs_sim_time(const cs_sim *sim) { return sim->t; }
 double cs_sim_dt(const cs_sim *sim) { return sim->dt; }
 double cs_sim_stable_dt(const cs_sim *sim) { return sim->stable_dt; }
@@ -534,6 +515,20 @@ const cs_stage_timing *cs_sim_stage_timing(const cs_sim *sim)
 const cs_comm_stats *cs_sim_stage_comm(const cs_sim *sim)
 {
     return sim->par->size > 1 ? sim->comm_all : sim->par->stats;
+}
+/* here, not in runaway.c: the stage's name is the stage table's, which
+ * lies above the checks */
+bool cs_sim_runaway(const cs_sim *sim, const char **stage, double *speed, double *limit)
+{
+    if (sim->runaway.stage < 0)
+        return false;
+    if (stage)
+        *stage = cs_stage_name((cs_stage)sim->runaway.stage);
+    if (speed)
+        *speed = sim->runaway.speed;
+    if (limit)
+        *limit = sim->runaway.limit;
+    return true;
 }
 int cs_sim_agree(cs_sim *sim, int value) { return cs_par_bcast_int(sim->par, value); }
 int cs_sim_rank(const cs_sim *sim) { return sim->par->rank; }

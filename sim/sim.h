@@ -165,18 +165,6 @@ cs_body_def cs_default_body_def(void);
 /* Signed distance and unit gradient of a body at world point x, time t. */
 double cs_body_def_phi(const cs_body_def *b, double t, const double x[3], double grad[3]);
 
-/* The body's Coulomb coefficient at time t: `friction`, or its schedule
- * evaluated at t (see cs_body_def.friction_keys). */
-double cs_body_def_friction(const cs_body_def *b, double t);
-
-/* Velocity at time t of the body material point at world position x. */
-void cs_body_def_velocity(const cs_body_def *b, double t, const double x[3], double v[3]);
-
-/* A world box at time t holding every point where the body's phi < offset
- * (the region where it collides). False for an unbounded body (a plane, or
- * phi_fn without phi_bounded). */
-bool cs_body_def_bounds(const cs_body_def *b, double t, double lo[3], double hi[3]);
-
 /* ---------------------------------------------------------------- cloth */
 
 /* The paper's Table 1. Stiffnesses are Young's moduli of the spring force
@@ -251,12 +239,6 @@ typedef struct cs_wind_def {
     double gust_length;      /* m, > 0 (default 1) */
     double gust_period;      /* s, > 0 (default 2) */
 } cs_wind_def;
-
-/* The wind at point p and time t (the +y axis is up in every scene). */
-void cs_wind_at(const cs_wind_def *w, const double p[3], double t, double out[3]);
-
-/* The fastest wind cs_wind_at can give anywhere, at any time. */
-double cs_wind_max_speed(const cs_wind_def *w);
 
 /* Self-collision (Sections 4 and 5). Defaults from Table 1. */
 typedef enum cs_collision_scheme {
@@ -384,10 +366,15 @@ typedef struct cs_plan {
     cs_stage stages[CS_STAGE_COUNT];
 } cs_plan;
 
-/* What the scene definition calls for, without creating anything: its
- * stages in the order they run. */
-cs_plan cs_plan_from_def(const cs_sim_def *def);
-bool cs_plan_has(const cs_plan *plan, cs_stage stage);
+/* Inline: the stages ask it, and plan.c, which reads the stage table,
+ * lies above them. */
+static inline bool cs_plan_has(const cs_plan *plan, cs_stage stage)
+{
+    for (int i = 0; i < plan->nstages; i++)
+        if (plan->stages[i] == stage)
+            return true;
+    return false;
+}
 
 typedef struct cs_stage_timing {
     double seconds;
@@ -563,10 +550,6 @@ long cs_count_intersections(int nv, const double *x, int nt, const int *tri);
  * in increasing order, pair k as triangles pairs[2k] < pairs[2k + 1]. */
 long cs_find_intersections(int nv, const double *x, int nt, const int *tri, int maxpairs,
                            int *pairs);
-
-/* The exact narrow phase alone: whether the closed triangles p and q
- * (3 vertices of 3 doubles each, possibly degenerate) intersect. */
-bool cs_triangles_intersect(const double p[9], const double q[9]);
 
 /* ------------------------------------------- state for resuming (checkpoint.c) */
 

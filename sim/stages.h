@@ -1,6 +1,7 @@
 /* stages.h: the rows of the stage table (stages.c) and what they run
  * with, private to sim/. A row's work lives with its kind: a time step's
- * stages in step.c, the outer step's and the frame's in frame.c. */
+ * stages in step.c, the outer step's and the frame's in frame.c; the
+ * loops that run a step, an outer step and a frame are stages.c's. */
 #ifndef CS_STAGES_H
 #define CS_STAGES_H
 
@@ -65,6 +66,10 @@ typedef struct cs_stage_row {
 /* The table, CS_STAGE_COUNT rows in the order they run. */
 const cs_stage_row *cs_stage_rows(void);
 bool cs_stage_need_met(cs_stage_need need, const cs_sim_def *def);
+
+/* plan.c: what the scene definition calls for, without creating anything:
+ * its stages in the order they run. */
+cs_plan cs_plan_from_def(const cs_sim_def *def);
 
 /* Runs the planned rows of a phase in order, each timed, counted and its
  * velocity checked in this one place; stops at the first failure (but for

@@ -1,6 +1,5 @@
 /* step.c: the time step of Section 3: its stages' work (the stage table
- * in stages.c runs them) and one step around them. */
-#include <math.h>
+ * in stages.c runs them, and makes the step around them). */
 #include <omp.h>
 #include <string.h>
 
@@ -232,27 +231,4 @@ const double *cs_stage_body_friction(cs_sim *sim, cs_stage_ctx *st)
 const double *cs_stage_self_friction(cs_sim *sim, cs_stage_ctx *st)
 {
     return repulsed(sim, cs_selfcol_repulse(sim, sim->x, sim->v_next, st->dt, false), sim->v_next);
-}
-
-/* True on every rank when every owned particle is finite everywhere. */
-int cs_sim_step(cs_sim *sim, double dt)
-{
-    cs_par *par = sim->par;
-    cs_stage_ctx st = {.status = CS_OK, .dt = dt, .t1 = sim->t + dt,
-                       .bodies = cs_plan_has(&sim->plan, CS_STAGE_BODY_COLLISION)};
-    if (fabs(st.t1 - sim->frame_end) <= 1e-9 * dt)
-        st.t1 = sim->frame_end; /* the frame's last step lands on its end */
-    sim->half_dt = 0.5 * dt;
-    /* x (owned and ghosts) is current here; v only where owned. One pass
-     * keeps x^n and resets the modes (the ghosts' are never read). */
-    cs_scripts_release(sim, dt);
-    CS_PARALLEL_FOR_LOCAL(par, i) {
-        memcpy(sim->x_prev + 3 * i, sim->x + 3 * i, 3 * sizeof(double));
-        sim->mode[i] = sim->is_free[i] ? CS_FREE : CS_FIXED;
-    }
-    cs_runaway_begin_step(sim, st.t1);
-    cs_stages_run(sim, CS_PHASE_STEP, &st);
-    int not_finite = cs_runaway_not_finite(sim, sim->v_next); /* v^(n+1) taken too */
-    sim->t = st.t1;
-    return cs_runaway_end_step(sim, not_finite) ? CS_OK : CS_ERR_UNSTABLE;
 }

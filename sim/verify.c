@@ -2,7 +2,8 @@
  *
  * The proof that the cloth stayed collision-free (Selle et al., Sections 4-5)
  * must not lean on the code it checks, so this file shares nothing with the
- * collision code but sim.h: its own broad phase, its own narrow phase, and
+ * collision code but sim.h (and the simulation's cloths, internal.h, for
+ * cs_sim_count_intersections): its own broad phase, its own narrow phase, and
  * exact predicates (sim/predicates.c: filtered doubles, expansion
  * arithmetic, GMP) so that no answer depends on a tolerance.
  *
@@ -34,6 +35,7 @@
  * way, after an exact coplanarity check and a projection that is injective
  * on the points' affine hull.
  */
+#include "sim/internal.h"
 #include "sim/sim.h"
 
 #include "sim/predicates.h"
@@ -521,4 +523,26 @@ done:
 long cs_count_intersections(int nv, const double *x, int nt, const int *tri)
 {
     return cs_find_intersections(nv, x, nt, tri, 0, NULL);
+}
+
+/* here, with the verifier, for the verify stage (frame.c) below sim.c */
+long cs_sim_count_intersections(const cs_sim *sim)
+{
+    /* every cloth's triangles in global particle indices, as one mesh */
+    long nt = 0;
+    for (int c = 0; c < sim->ncloths; c++)
+        nt += sim->cloths[c].mesh->nt;
+    int *tri = malloc(sizeof *tri * 3 * (size_t)(nt + 1));
+    if (!tri)
+        return -1;
+    long t = 0;
+    for (int c = 0; c < sim->ncloths; c++) {
+        const cs_trimesh *m = sim->cloths[c].mesh;
+        for (int k = 0; k < 3 * m->nt; k++)
+            tri[3 * t + k] = sim->cloths[c].offset + m->tri[k];
+        t += m->nt;
+    }
+    long count = cs_count_intersections(sim->n, sim->x, (int)nt, tri);
+    free(tri);
+    return count;
 }

@@ -16,6 +16,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "sim/body_grid.h"
 #include "sim/sim.h"
 
 static double urand(double lo, double hi) { return lo + (hi - lo) * rand() / (double)RAND_MAX; }

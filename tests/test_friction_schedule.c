@@ -30,6 +30,7 @@
 #include <string.h>
 
 #include "import/import.h"
+#include "sim/internal.h"
 
 #define G 9.8
 #define THETA_DEG 36.0

@@ -17,6 +17,7 @@
 #include <unistd.h>
 
 #include "import/import.h"
+#include "sim/internal.h"
 #include "tests/scene_load.h"
 
 #define EPS 1e-12

@@ -2,7 +2,8 @@
  * rows in the table's order, and the stages that run are exactly the
  * plan's: every planned stage runs as often as its place in the loop says
  * (each time step, each outer step, each frame), every other one never
- * runs and owns no memory. Only the public interface is used. */
+ * runs and owns no memory. Only the public interface is used, and the
+ * plan read off a definition (cs_plan_from_def, sim/stages.h). */
 #include <stdarg.h>
 #include <stddef.h>
 #include <stdint.h>
@@ -13,6 +14,7 @@
 #include <string.h>
 
 #include "sim/sim.h"
+#include "sim/stages.h"
 #include "grid_cloth.h"
 
 static void test_table_names_every_stage_once(void **state)

@@ -13,6 +13,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "sim/internal.h"
 #include "sim/sim.h"
 #include "terms_sim.h"
 
