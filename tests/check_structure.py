@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""check_structure.py BUILD_DIR: the dependency structure of the built code.
+"""check_structure.py BUILD_DIR SOURCE_DIR: the dependency structure of the built code.
 
 Reads the symbols of every object file of clothsim's libraries and command
 (nm) and fails when
@@ -28,23 +28,26 @@ TARGETS = {"clothsim_common": "common", "clothsim_sim": "sim", "clothsim_levelse
            "clothsim_import": "import", "clothsim_render": "render", "clothsim": "app"}
 
 
-def objects(build):
+def objects(build, source):
+    """(library, file, object) for every object whose source file still
+    exists (a build tree keeps the objects of removed files)."""
     found = []
     for target, lib in TARGETS.items():
         root = os.path.join(build, "CMakeFiles", target + ".dir")
         for path in glob.glob(os.path.join(root, "**", "*.o"), recursive=True):
             name = os.path.relpath(path, root)
-            for ext in (".c.o", ".cpp.o"):
-                if name.endswith(ext):
-                    name = name[: -len(ext)]
-            found.append((lib, name, path))
+            for ext in (".c", ".cpp"):
+                if name.endswith(ext + ".o"):
+                    name = name[: -len(ext) - 2]
+                    if os.path.isfile(os.path.join(source, name + ext)):
+                        found.append((lib, name, path))
     return found
 
 
 def main():
-    if len(sys.argv) != 2:
-        sys.exit("usage: check_structure.py BUILD_DIR")
-    objs = objects(sys.argv[1])
+    if len(sys.argv) != 3:
+        sys.exit("usage: check_structure.py BUILD_DIR SOURCE_DIR")
+    objs = objects(sys.argv[1], sys.argv[2])
     if len(objs) < 20:
         sys.exit("check_structure: found only %d object files under %s" % (len(objs), sys.argv[1]))
     defined, undefined, library = {}, collections.defaultdict(set), {}
