@@ -54,6 +54,11 @@ void cs_run_print_plan(const cs_scene *scene, const cs_sim *sim, FILE *out)
         if (damped)
             fprintf(out, ": the step is chosen again before every outer step, smaller where "
                     "the cloth is stretched");
+        const char *why = cs_sim_step_limit_why(sim);
+        if (why)
+            fprintf(out, "\n    (the damped limit at rest is %.1f times the undamped one, "
+                    "auto_min_gain %g; %s)", cs_sim_damped_dt(sim) / cs_sim_undamped_dt(sim),
+                    scene->def.auto_min_gain, why);
         fputc('\n', out);
     }
     if (scene->def.self_collision && scene->def.self.pruning == CS_PRUNING_PATH)

@@ -125,6 +125,7 @@ struct cs_sim {
     double frame_end;             /* advance_frame's end time: a step that
                                    * lands within round-off of it lands on it */
     cs_step_limit step_limit;     /* def.step_limit with auto resolved */
+    const char *step_limit_why;   /* what decided auto (NULL: not auto) */
     double stable_dt;             /* the limit step_limit names, at rest */
     double damped_dt;             /* the damped scheme's limit at rest (step_limit.c) */
     double undamped_dt;           /* 2 / omega_max, omega_max^2 by Lanczos */

@@ -497,6 +497,7 @@ double cs_sim_stable_dt(const cs_sim *sim) { return sim->stable_dt; }
 double cs_sim_undamped_dt(const cs_sim *sim) { return sim->undamped_dt; }
 double cs_sim_damped_dt(const cs_sim *sim) { return sim->damped_dt; }
 cs_step_limit cs_sim_step_limit(const cs_sim *sim) { return sim->step_limit; }
+const char *cs_sim_step_limit_why(const cs_sim *sim) { return sim->step_limit_why; }
 double cs_sim_gershgorin_dt(const cs_sim *sim) { return sim->gershgorin_dt; }
 int cs_sim_particle_count(const cs_sim *sim) { return sim->n; }
 int cs_sim_spring_count(const cs_sim *sim) { return sim->nsprings; }

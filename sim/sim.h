@@ -489,6 +489,9 @@ double cs_sim_stable_dt(const cs_sim *sim);
 double cs_sim_damped_dt(const cs_sim *sim);
 /* the limit the automatic step uses: def.step_limit, auto resolved */
 cs_step_limit cs_sim_step_limit(const cs_sim *sim);
+/* what decided step_limit auto's choice, a phrase (NULL when the
+ * definition named the limit itself) */
+const char *cs_sim_step_limit_why(const cs_sim *sim);
 double cs_sim_undamped_dt(const cs_sim *sim);
 double cs_sim_gershgorin_dt(const cs_sim *sim);
 int cs_sim_particle_count(const cs_sim *sim);

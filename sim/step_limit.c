@@ -118,11 +118,19 @@ static bool moving_scripts(const cs_sim *sim)
  * C's zones can resolve) and the projection friction method (at the damped
  * step the rolling cloth sinks 4.5 mm into the incline, against under 1 mm
  * at the undamped one). */
-static bool auto_takes_damped(const cs_sim *sim)
+static bool auto_takes_damped(cs_sim *sim)
 {
-    if (moving_scripts(sim) || sim->def.friction_method != CS_FRICTION_IMPROVED)
+    if (moving_scripts(sim)) {
+        sim->step_limit_why = "vertices moved by a script keep the undamped step";
         return false;
-    return sim->damped_dt >= sim->def.auto_min_gain * sim->undamped_dt;
+    }
+    if (sim->def.friction_method != CS_FRICTION_IMPROVED) {
+        sim->step_limit_why = "the projection friction method keeps the undamped step";
+        return false;
+    }
+    bool gain = sim->damped_dt >= sim->def.auto_min_gain * sim->undamped_dt;
+    sim->step_limit_why = gain ? "the gain is at least auto_min_gain" : "the gain is below auto_min_gain";
+    return gain;
 }
 
 void cs_step_limit_init(cs_sim *sim)
@@ -144,6 +152,7 @@ void cs_step_limit_init(cs_sim *sim)
                         : INFINITY;
     sim->damped_dt = fmax(sim->undamped_dt, damped);
     sim->step_limit = sim->def.step_limit;
+    sim->step_limit_why = NULL;
     if (sim->step_limit == CS_STEP_AUTO)
         sim->step_limit = auto_takes_damped(sim) ? CS_STEP_DAMPED : CS_STEP_UNDAMPED;
     sim->stable_dt = sim->step_limit == CS_STEP_DAMPED ? sim->damped_dt : sim->undamped_dt;

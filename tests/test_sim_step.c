@@ -195,6 +195,7 @@ static void test_auto_takes_damped_above_its_gain(void **state)
         assert_non_null(sim);
         cs_step_limit want = above ? CS_STEP_UNDAMPED : CS_STEP_DAMPED;
         assert_int_equal(cs_sim_step_limit(sim), want);
+        assert_non_null(strstr(cs_sim_step_limit_why(sim), above ? "below" : "at least"));
         double limit = above ? cs_sim_undamped_dt(sim) : cs_sim_damped_dt(sim);
         assert_true(fabs(cs_sim_stable_dt(sim) - limit) <= 1e-12 * limit);
         cs_sim_destroy(sim);
