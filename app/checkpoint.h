@@ -60,6 +60,11 @@ void cs_run_identity_free(cs_run_identity *id);
  * frame holds them all), as 32 hex digits (CS_STATE_HASH_ALGORITHM). */
 void cs_state_hash(const cs_sim *sim, char hex[CS_STATE_HASH_LEN]);
 
+/* The state file of a run folder, "state.h5"; NULL in a build without
+ * HDF5 (checkpoint_none.c), which keeps none: there cs_checkpoint_write
+ * writes nothing and cs_checkpoint_read refuses to resume. */
+const char *cs_checkpoint_file_name(void);
+
 /* Rank 0, after cs_sim_state_gather: writes path atomically with the
  * identity, the frame, its state hash and the summary totals
  * (CS_SUMMARY_TOTALS doubles). Returns 0, or -1 with err naming the file. */

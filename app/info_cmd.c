@@ -25,7 +25,6 @@
 #include <errno.h>
 #include <getopt.h>
 #include <math.h>
-#include <plplot.h>
 #include <stdbool.h>
 #include <stdlib.h>
 #include <string.h>
@@ -132,95 +131,15 @@ static double *scene_masses(const cs_scene *scene, int *nv_out)
 
 /* ------------------------------------------------------------------ plot */
 
-static void range_of(const double *y, int n, double *lo, double *hi)
+/* DIR/info.png from the rows: the columns as series against time, NaN
+ * where a row has no value (info_plot.c draws them). Returns 0, or -1
+ * with err. */
+static int write_plot(const char *path, const info_ctx *ctx, char *err, size_t errlen)
 {
-    *lo = INFINITY;
-    *hi = -INFINITY;
-    for (int i = 0; i < n; i++)
-        if (isfinite(y[i])) {
-            *lo = fmin(*lo, y[i]);
-            *hi = fmax(*hi, y[i]);
-        }
-    if (!isfinite(*lo))
-        *lo = 0, *hi = 1;
-    double span = *hi - *lo;
-    if (!(span > 0))
-        span = fabs(*hi) > 0 ? fabs(*hi) : 1;
-    *lo -= 0.05 * span;
-    *hi += 0.05 * span;
-}
-
-/* Draws the finite points of y against x as a line (and dots). */
-static void curve(const double *x, const double *y, int n, PLINT colour, PLINT style)
-{
-    PLFLT *px = malloc(sizeof *px * ((size_t)n + 1)), *py = malloc(sizeof *py * ((size_t)n + 1));
-    int m = 0;
-    for (int i = 0; px && py && i < n; i++)
-        if (isfinite(x[i]) && isfinite(y[i])) {
-            px[m] = x[i];
-            py[m++] = y[i];
-        }
-    plcol0(colour);
-    pllsty(style);
-    if (m > 1)
-        plline(m, px, py);
-    if (m > 0)
-        plstring(m, px, py, "#(728)");
-    pllsty(1);
-    free(px);
-    free(py);
-}
-
-static void panel(const double *t, int n, const double *const *ys, const char *const *labels,
-                  int ncurves, const char *ylabel, const char *title)
-{
-    double xlo, xhi, ylo = INFINITY, yhi = -INFINITY;
-    range_of(t, n, &xlo, &xhi);
-    for (int c = 0; c < ncurves; c++) {
-        double lo, hi;
-        range_of(ys[c], n, &lo, &hi);
-        ylo = fmin(ylo, lo);
-        yhi = fmax(yhi, hi);
-    }
-    if (ncurves > 1) /* room for the legend above the curves */
-        yhi += 0.15 * ncurves * (yhi - ylo);
-    if (ncurves == 1 && ylo < 0 && ylo > -1) /* a count: from 0, at least to 1 */
-        yhi = fmax(yhi, 1), ylo = -0.04 * yhi;
-    static const PLINT colours[] = {1, 9, 3, 8};
-    plcol0(15);
-    plenv(xlo, xhi, ylo, yhi, 0, 0);
-    pllab("time (s)", ylabel, title);
-    for (int c = 0; c < ncurves; c++)
-        curve(t, ys[c], n, colours[c % 4], 1 + c / 4);
-    if (ncurves > 1) {
-        PLINT opts[4], cols[4], styles[4], nsym[4];
-        PLFLT widths[4], scales[4];
-        const char *syms[4];
-        for (int c = 0; c < ncurves && c < 4; c++) {
-            opts[c] = PL_LEGEND_LINE;
-            cols[c] = colours[c];
-            styles[c] = 1;
-            widths[c] = 1;
-            scales[c] = 1;
-            nsym[c] = 1;
-            syms[c] = "#(728)";
-        }
-        PLFLT lw, lh;
-        plcol0(15);
-        pllegend(&lw, &lh, PL_LEGEND_BACKGROUND | PL_LEGEND_BOUNDING_BOX,
-                 PL_POSITION_TOP | PL_POSITION_RIGHT | PL_POSITION_INSIDE, 0.02, 0.02, 0.08, 0,
-                 15, 1, 0, 0, ncurves < 4 ? ncurves : 4, opts, 1.0, 0.8, 2.0, 0.0, cols,
-                 labels, NULL, NULL, NULL, NULL, cols, styles, widths, cols, scales, nsym, syms);
-    }
-}
-
-static int fill_plot(const char *tmp, void *vctx, char *why, size_t whylen)
-{
-    const info_ctx *ctx = vctx;
     int n = ctx->nrows;
     double *buf = calloc(7 * ((size_t)n + 1), sizeof *buf);
     if (!buf) {
-        snprintf(why, whylen, "out of memory");
+        snprintf(err, errlen, "out of memory");
         return -1;
     }
     double *t = buf, *pairs = t + n + 1, *ke = pairs + n + 1, *pe = ke + n + 1,
@@ -240,25 +159,10 @@ static int fill_plot(const char *tmp, void *vctx, char *why, size_t whylen)
         vs[i] = r->max_speed;
         fd[i] = r->fd_speed;
     }
-    if (cs_plot_open(tmp, 900, 1100, why, whylen) != 0) {
-        free(buf);
-        return -1;
-    }
-    plssub(1, 3);
-    plinit();
-    const double *y1[] = {pairs};
-    const char *l1[] = {"pairs"};
-    panel(t, n, y1, l1, 1, "pairs", ctx->title);
-    const double *y2[] = {ke, pe, tot};
-    const char *l2[] = {"kinetic (from positions)", "potential (gravity) - frame 0's",
-                        "kinetic + mid-frame potential - frame 1's"};
-    panel(t, n, y2, l2, 3, "energy (J)", "energy");
-    const double *y3[] = {vs, fd};
-    const char *l3[] = {"max_speed (frames.jsonl)", "max |dx| fps (positions)"};
-    panel(t, n, y3, l3, 2, "speed (m/s)", "largest vertex speed");
-    plend();
+    cs_info_figure fig = {ctx->title, n, t, pairs, ke, pe, tot, vs, fd};
+    int rc = cs_info_plot(path, &fig, err, errlen);
     free(buf);
-    return 0;
+    return rc;
 }
 
 /* ------------------------------------------------------------------ main */
@@ -296,6 +200,10 @@ int cs_info_main(int argc, char **argv)
         return status;
 
     char err[ERRLEN] = "", path[4096];
+    if (plot && cs_plot_available(err, sizeof err) != 0) { /* before the table */
+        fprintf(stderr, "clothsim info: %s (--no-plot prints the table alone)\n", err);
+        return CS_EXIT_OUTPUT;
+    }
     cs_run_info info;
     if ((status = cs_run_info_read(dir, &info, err, sizeof err)) != CS_EXIT_OK) {
         fprintf(stderr, "clothsim info: %s\n", err);
@@ -487,7 +395,7 @@ int cs_info_main(int argc, char **argv)
         snprintf(ctx.title, sizeof ctx.title, "%s (%s): intersecting pairs", scene->name,
                  run_status);
         snprintf(path, sizeof path, "%s/info.png", dir);
-        if (cs_write_atomic(path, false, fill_plot, &ctx, err, sizeof err) != 0) {
+        if (write_plot(path, &ctx, err, sizeof err) != 0) {
             fprintf(stderr, "clothsim info: %s\n", err);
             status = CS_EXIT_OUTPUT;
             goto done;

@@ -3,6 +3,7 @@
  * Only dispatch lives here, on one table of commands; each command has its
  * own file (run.c, render_cmd.c, ...). A new command, or a help topic
  * (`clothsim help scene`: a row with topic set), is a new row. */
+#include "app/build_info.h"
 #include "app/check_cmd.h"
 #include "app/cli.h"
 #include "app/export_cmd.h"
@@ -122,12 +123,16 @@ int main(int argc, char **argv)
     }
     if (strcmp(name, "-V") == 0 || strcmp(name, "--version") == 0) {
         printf("clothsim %s\n", CS_VERSION);
+        cs_build_print_parts(stdout);
         return CS_EXIT_OK;
     }
     const cs_command *c = find_command(name);
     if (c && !c->topic) {
         if (!c->parallel)
             return c->main(argc - 1, argv + 1);
+        int refused = cs_build_check_ranks();
+        if (refused)
+            return refused;
         cs_parallel_init(&argc, &argv);
         int status = c->main(argc - 1, argv + 1);
         cs_parallel_finalize();

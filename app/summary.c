@@ -197,7 +197,8 @@ static cJSON *build_json(const cs_summary *s, builder *b)
     add_num(b, root, "output_seconds", s->output_seconds);
 
     add_str(b, root, "frames_file", "frames.jsonl");
-    add_str(b, root, "state_file", "state.h5");
+    if (cs_checkpoint_file_name()) /* none without HDF5 */
+        add_str(b, root, "state_file", cs_checkpoint_file_name());
     add_str(b, root, "state_hash_algorithm", CS_STATE_HASH_ALGORITHM);
     if (s->initial_hash[0])
         add_str(b, root, "initial_state_hash", s->initial_hash);

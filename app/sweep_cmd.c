@@ -656,6 +656,11 @@ int cs_sweep_main(int argc, char **argv)
     int nruns = 0, ref = -1;
     cs_scene *scene = NULL;
     int status = parse_options(argc, argv, &o);
+    char why[256];
+    if (status < 0 && cs_plot_available(why, sizeof why) != 0) { /* before any run */
+        fprintf(stderr, "clothsim sweep: %s\n", why);
+        status = CS_EXIT_OUTPUT;
+    }
     if (status < 0)
         status = validate_values(&o);
     if (status < 0)

@@ -26,6 +26,10 @@ typedef struct cs_sweep_curve {
     bool points;        /* a filled circle at each point */
 } cs_sweep_curve;
 
+/* The corner a picture's legend goes in (cs_sweep_figure.legend): these
+ * bits, none for the bottom left. */
+enum { CS_LEGEND_RIGHT = 1, CS_LEGEND_TOP = 2 };
+
 /* A picture: curves on linear or log axes with a legend. */
 typedef struct cs_sweep_figure {
     const char *title, *xlabel, *ylabel;
@@ -34,7 +38,7 @@ typedef struct cs_sweep_figure {
     int ncurves;
     double mark_x;          /* > 0: a dashed vertical line at x = mark_x ... */
     const char *mark_label; /* ... labelled at its foot (NULL: none) */
-    int legend;             /* where: PL_POSITION_TOP | PL_POSITION_RIGHT, ...;
+    int legend;             /* where: CS_LEGEND_TOP | CS_LEGEND_RIGHT, ...;
                                another corner when the curves are there */
 } cs_sweep_figure;
 
@@ -42,6 +46,10 @@ typedef struct cs_sweep_figure {
  * atomically. The one plotting helper of sweep.png, trajectory.png and
  * cumulative_time.png. Returns 0, or -1 with err (sweep_plot.c). */
 int cs_sweep_plot(const char *path, const cs_sweep_figure *figure, char *err, size_t errlen);
+
+/* 0 where this build draws pictures; -1 with why in a build without
+ * PLplot (plot_none.c), so that a command can refuse before its work. */
+int cs_plot_available(char *why, size_t whylen);
 
 /* Whether PLplot has its pngcairo device (without it, PLplot would ask for
  * a device on the terminal); also bench/scaling_plot.c's check. */

@@ -12,7 +12,6 @@
 #include "common/util.h"
 
 #include <math.h>
-#include <plplot.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -147,7 +146,7 @@ static int plot_error(const sweep_options *o, const sweep_run *runs, int nruns, 
         "clothsim sweep: error against cost", "wall seconds of the run",
         o->analytic ? "error against the analytic solution, m" : "error against the reference, m",
         true, true, curves, o->nknobs, runs[ref].wall, "reference",
-        PL_POSITION_TOP | PL_POSITION_RIGHT};
+        CS_LEGEND_TOP | CS_LEGEND_RIGHT};
     rc = draw(o, "sweep.png", &fig, err, errlen);
 done:
     free(curves);
@@ -239,7 +238,7 @@ static int plot_trajectory(const sweep_options *o, const sweep_run *runs, int nr
         curves[c].label = labels[c];
     cs_sweep_figure fig = {"clothsim sweep: distance travelled down the slope", "time, s",
                            "centre of mass: distance down the slope, m", false, false, curves, n,
-                           0, NULL, PL_POSITION_TOP | PL_POSITION_LEFT};
+                           0, NULL, CS_LEGEND_TOP};
     rc = draw(o, "trajectory.png", &fig, err, errlen);
 done:
     for (int c = 0; labels && c < n; c++)
@@ -298,7 +297,7 @@ static int plot_cumulative(const sweep_options *o, const sweep_run *runs, int nr
     }
     cs_sweep_figure fig = {"clothsim sweep: cumulative wall time", "frame",
                            "wall seconds, summed over the frames so far", false, log_y, curves, n,
-                           0, NULL, PL_POSITION_TOP | PL_POSITION_LEFT};
+                           0, NULL, CS_LEGEND_TOP};
     rc = draw(o, "cumulative_time.png", &fig, err, errlen);
 done:
     for (int c = 0; labels && c < n; c++)

@@ -1,7 +1,8 @@
 /* sweep_plot.c: the one plotting helper of `clothsim sweep`'s pictures
  * (sweep.png, trajectory.png, cumulative_time.png): curves on linear or
  * log axes with a legend, drawn by PLplot's pngcairo device into a PNG
- * that appears atomically. */
+ * that appears atomically. A build without PLplot compiles plot_none.c
+ * instead. */
 #include "app/sweep_cmd.h"
 
 #include "common/util.h"
@@ -59,6 +60,12 @@ static void curve_pen(const cs_sweep_figure *f, int c, PLINT *colour, PLINT *sty
     *style = f->curves[c].style > 0 ? f->curves[c].style : 1 + (k / NPALETTE) % 8;
 }
 
+int cs_plot_available(char *why, size_t whylen)
+{
+    (void)why, (void)whylen;
+    return 0;
+}
+
 bool cs_plot_has_pngcairo(void)
 {
     PLCHAR_VECTOR menus[128], devs[128], *pm = menus, *pd = devs;
@@ -93,7 +100,7 @@ static bool in_corner(int c, double u, double v, double w, double h)
     return (right ? u >= 1 - w : u <= w) && (top ? v >= 1 - h : v <= h);
 }
 
-/* The corner for the legend (PL_POSITION_* bits): of the four, the one
+/* The corner for the legend (as PL_POSITION_* bits): of the four, the one
  * whose box of the legend's size the fewest curve samples (points, and
  * points along each segment; the marked line and its label) fall in; the
  * figure's choice among equals. */
@@ -123,7 +130,7 @@ static PLINT legend_corner(const cs_sweep_figure *f, int entries, const double b
         for (int k = 0; k <= 4; k++) /* its label, left of its foot */
             hits[corner] += 4 * in_corner(corner, um - 0.04 * k, 0.03, w, h);
     }
-    int want = (f->legend & PL_POSITION_RIGHT ? 1 : 0) | (f->legend & PL_POSITION_TOP ? 2 : 0);
+    int want = (f->legend & CS_LEGEND_RIGHT ? 1 : 0) | (f->legend & CS_LEGEND_TOP ? 2 : 0);
     int best = want;
     for (int corner = 0; corner < 4; corner++)
         if (hits[corner] < hits[best])

@@ -26,6 +26,13 @@ typedef enum cs_status {
  * value that is none of the above. */
 const char *cs_status_message(int status);
 
+/* The sentence of a build without an optional part, where the part is
+ * needed (the stand-ins of docs/building.md): PART the library, WHAT what
+ * needs it ("--resume and checkpoints need it"), OPTION its CMake option;
+ * all three string literals. */
+#define CS_MISSING_PART(part, what, option) \
+    "this build has no " part ": " what "; rebuild with -D" option "=ON"
+
 #ifdef __cplusplus
 }
 #endif

@@ -37,31 +37,6 @@
 
 #define set_err cs_mesh_set_err
 
-cs_mesh_placement cs_default_mesh_placement(void)
-{
-    cs_mesh_placement p;
-    memset(&p, 0, sizeof p);
-    p.scale[0] = p.scale[1] = p.scale[2] = 1;
-    p.rotation[0] = 1;
-    return p;
-}
-
-bool cs_mesh_units_from_name(const char *name, double *metres)
-{
-    static const struct {
-        const char *name;
-        double metres;
-    } units[] = {{"m", 1}, {"cm", 0.01}, {"mm", 0.001}, {"km", 1000},
-                 {"in", 0.0254}, {"ft", 0.3048}};
-    for (size_t i = 0; name && i < sizeof units / sizeof *units; i++)
-        if (strcmp(name, units[i].name) == 0) {
-            if (metres)
-                *metres = units[i].metres;
-            return true;
-        }
-    return false;
-}
-
 /* ----------------------------------------------------------- opening */
 
 /* Opens with assimp (in the guard's child); on failure says why, the

@@ -35,42 +35,14 @@
 
 /* -------------------------------------------------------------- formats */
 
-typedef struct format_info {
-    const char *extension;
-    const char *assimp_id;   /* aiExportScene format id */
-} format_info;
-
-static const format_info FORMATS[] = {
-    [CS_MESH_PLY] = {"ply", "plyb"},      /* binary PLY */
-    [CS_MESH_OBJ] = {"obj", "objnomtl"},  /* OBJ without a .mtl file */
-    [CS_MESH_GLB] = {"glb", "glb2"},      /* glTF 2.0 binary */
+/* aiExportScene's format id of each cs_mesh_format (the names and
+ * extensions are mesh_format.c's) */
+static const char *const ASSIMP_IDS[] = {
+    [CS_MESH_PLY] = "plyb",      /* binary PLY */
+    [CS_MESH_OBJ] = "objnomtl",  /* OBJ without a .mtl file */
+    [CS_MESH_GLB] = "glb2",      /* glTF 2.0 binary */
 };
-#define NFORMATS ((int)(sizeof FORMATS / sizeof FORMATS[0]))
-
-bool cs_mesh_format_from_name(const char *name, cs_mesh_format *format)
-{
-    if (!name)
-        return false;
-    cs_mesh_format f;
-    if (strcasecmp(name, "ply") == 0)
-        f = CS_MESH_PLY;
-    else if (strcasecmp(name, "obj") == 0)
-        f = CS_MESH_OBJ;
-    else if (strcasecmp(name, "glb") == 0 || strcasecmp(name, "gltf") == 0)
-        f = CS_MESH_GLB;
-    else
-        return false;
-    if (format)
-        *format = f;
-    return true;
-}
-
-const char *cs_mesh_format_extension(cs_mesh_format format)
-{
-    if ((int)format < 0 || (int)format >= NFORMATS)
-        return NULL;
-    return FORMATS[format].extension;
-}
+#define NFORMATS ((int)(sizeof ASSIMP_IDS / sizeof ASSIMP_IDS[0]))
 
 /* --------------------------------------------------------------- writing */
 
@@ -362,7 +334,7 @@ int cs_mesh_write(const char *path, cs_mesh_format format, int nmeshes,
      * write checked: assimp's own file writer ignores a short fwrite and
      * fclose's result, so a full disk would give a truncated frame. */
     const struct aiExportDataBlob *blob =
-        scene ? aiExportSceneToBlob(scene, FORMATS[format].assimp_id, 0) : NULL;
+        scene ? aiExportSceneToBlob(scene, ASSIMP_IDS[format], 0) : NULL;
     free_scene(scene);
     const void *data = blob ? blob->data : points.data;
     size_t size = blob ? blob->size : points.len;
@@ -370,7 +342,7 @@ int cs_mesh_write(const char *path, cs_mesh_format format, int nmeshes,
     int status = CS_OK;
     if (!data || size == 0) {
         set_err(err, errlen, "cannot write %s: assimp's '%s' exporter failed",
-                path, FORMATS[format].assimp_id);
+                path, ASSIMP_IDS[format]);
         status = CS_ERR_BAD_INPUT;
     } else if (cs_file_write_atomic(path, data, size, err, errlen) != 0) {
         status = CS_ERR_BAD_INPUT;

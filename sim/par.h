@@ -1,5 +1,6 @@
 /* par.h: distributed memory parallelism (Section 7), private to sim/. The
- * only file that calls MPI is par.c.
+ * only file that calls MPI is par.c; a build without MPI compiles it
+ * against par_one_rank.h instead of <mpi.h>.
  *
  * Every rank keeps the global particle arrays, indexed as on one rank, but
  * owns a subset of the particles (a recursive median split of the initial
@@ -19,7 +20,11 @@
 #include <stdbool.h>
 #include <stddef.h>
 
+#ifdef CS_HAVE_MPI
 #include <mpi.h>
+#else
+#include "sim/par_one_rank.h" /* a build without MPI: one rank (see there) */
+#endif
 
 #include "sim/sim.h"
 
