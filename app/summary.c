@@ -2,6 +2,7 @@
  * `clothsim run`. */
 #include "app/summary.h"
 
+#include "app/checkpoint.h"
 #include "common/util.h"
 
 #include <cJSON.h>
