@@ -1,6 +1,6 @@
 #!/bin/sh
 # The long tests (ctest label `long`: the paper figures at their test size,
-# every frame checked), which scripts/test.sh and CI leave out: builds the
+# every frame checked, and the twist under the hold policy), which scripts/test.sh and CI leave out: builds the
 # same ASan+UBSan tree as scripts/test.sh and runs only them.
 set -eu
 cd "$(dirname "$0")/.."
