@@ -35,10 +35,9 @@ import shutil
 import statistics
 import subprocess
 import sys
-import time
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from speed import ROOT, cpu_times, machine, triad  # noqa: E402
+from speed import ROOT, cpu_times, machine, timed_run, triad  # noqa: E402
 
 SHEET = os.path.join(ROOT, "scenes", "bench", "sheet_ball.yaml")
 TWIST_FRAMES = 2
@@ -46,20 +45,6 @@ TWIST_FRAMES = 2
 
 def die(msg):
     sys.exit("paper_scale.py: " + msg)
-
-
-def timed(args, out):
-    """Runs args (stdout and stderr into out/); returns (wall s, peak RSS MiB)."""
-    os.makedirs(out, exist_ok=True)
-    t0 = time.monotonic()
-    with open(os.path.join(out, "stdout.txt"), "w") as fo, \
-            open(os.path.join(out, "stderr.txt"), "w") as fe:
-        proc = subprocess.Popen(args, stdout=fo, stderr=fe)
-        _, status, usage = os.wait4(proc.pid, 0)
-    wall = time.monotonic() - t0
-    if os.waitstatus_to_exitcode(status) != 0:
-        die("%s failed:\n%s" % (" ".join(args), open(os.path.join(out, "stderr.txt")).read()))
-    return wall, usage.ru_maxrss / 1024.0
 
 
 def records(run_dir, after=0):
@@ -92,7 +77,7 @@ def drape(exe, n, thickness, repeat, out):
     runs = []
     for k in range(repeat):
         d = os.path.join(out, "drape_%d" % n)
-        wall, rss = timed(args + ["-o", d], d + "_log")
+        wall, rss, _ = timed_run(args + ["-o", d], d + "_log")
         runs.append((wall, rss, records(d)))
         print("  drape %dx%d run %d: %.3f s/frame" % (n, n, k + 1, wall / frames),
               file=sys.stderr, flush=True)
@@ -106,7 +91,7 @@ def twist(exe, state, repeat, out):
         d = os.path.join(out, "twist_resumed")
         shutil.rmtree(d, ignore_errors=True)
         shutil.copytree(state, d, symlinks=True)
-        wall, rss = timed([exe, "run", d, "--resume", "-q", "--frames", str(done + TWIST_FRAMES)],
+        wall, rss, _ = timed_run([exe, "run", d, "--resume", "-q", "--frames", str(done + TWIST_FRAMES)],
                           d + "_log")
         runs.append((wall, rss, records(d, done)))
         print("  twist from frame %d, run %d: %.1f s/frame" % (done, k + 1, wall / TWIST_FRAMES),

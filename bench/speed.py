@@ -41,6 +41,22 @@ def die(msg):
     sys.exit("speed.py: " + msg)
 
 
+def timed_run(args, log_dir):
+    """Runs args with stdout and stderr into log_dir; dies unless it exits 0.
+    Returns (wall seconds, this run's own peak RSS in MiB, stdout)."""
+    os.makedirs(log_dir, exist_ok=True)
+    log_out, log_err = os.path.join(log_dir, "stdout.txt"), os.path.join(log_dir, "stderr.txt")
+    t0 = time.monotonic()
+    with open(log_out, "w") as fo, open(log_err, "w") as fe:
+        proc = subprocess.Popen(args, stdout=fo, stderr=fe)
+        _, status, usage = os.wait4(proc.pid, 0)
+    wall = time.monotonic() - t0
+    code = os.waitstatus_to_exitcode(status)
+    if code != 0:
+        die("%s exited %d:\n%s" % (" ".join(args), code, open(log_err).read()))
+    return wall, usage.ru_maxrss / 1024.0, open(log_out).read()
+
+
 def run_once(exe, n, selfcol, frames, out, step_limit, pruning):
     """One whole run; returns (wall seconds, peak RSS MiB, summary, stage table text)."""
     thick = THICKNESS.get(n, 0.4 / n)
@@ -51,18 +67,7 @@ def run_once(exe, n, selfcol, frames, out, step_limit, pruning):
             "--set", "self_collision.pruning=" + pruning]
     if not selfcol:
         args += ["--set", "effects.self_collision=false"]
-    os.makedirs(out, exist_ok=True)
-    log_out, log_err = os.path.join(out, "stdout.txt"), os.path.join(out, "stderr.txt")
-    t0 = time.monotonic()
-    with open(log_out, "w") as fo, open(log_err, "w") as fe:
-        proc = subprocess.Popen(args, stdout=fo, stderr=fe)
-        _, status, usage = os.wait4(proc.pid, 0)  # this run's own peak memory
-    wall = time.monotonic() - t0
-    proc.returncode = os.waitstatus_to_exitcode(status)
-    rss = usage.ru_maxrss / 1024.0
-    stdout, stderr = open(log_out).read(), open(log_err).read()
-    if proc.returncode != 0:
-        die("%s exited %d:\n%s" % (" ".join(args), proc.returncode, stderr))
+    wall, rss, stdout = timed_run(args, out)
     with open(os.path.join(out, "summary.json")) as f:
         summary = json.load(f)
     table = "\n".join(l for l in stdout.splitlines()
