@@ -2,7 +2,7 @@
 # Installs the Debian 12 packages clothsim needs to build and test, only if
 # something is missing (so repeated runs cost nothing). Needs root and apt.
 set -eu
-PACKAGES="build-essential cmake pkg-config \
+PACKAGES="build-essential cmake ninja-build pkg-config \
   libembree-dev libassimp-dev libosmesa6-dev libopenmpi-dev openmpi-bin \
   libopenvdb-dev libboost-iostreams-dev libpng-dev libcyaml-dev libyaml-dev \
   libcjson-dev libcmocka-dev libcairo2-dev libgmp-dev libhdf5-dev libxxhash-dev libplplot-dev plplot-driver-cairo valgrind python3 ffmpeg"
