@@ -5,6 +5,6 @@
 set -eu
 cd "$(dirname "$0")/.."
 scripts/install-deps.sh
-cmake -S . -B build-asan -DCMAKE_BUILD_TYPE=Asan >/dev/null
+scripts/configure.sh build-asan Asan
 cmake --build build-asan -j"$(nproc)"
 cd build-asan && exec ctest --output-on-failure -j"$(nproc)" -L long "$@"

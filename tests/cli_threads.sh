@@ -46,8 +46,8 @@ same_frames stack1 stack2
 same_frames stack1 stack3
 
 # a drape with body contact (the sheet lands in frame 6), CG at work and
-# 625 particles: ten blocks of rows to share; the fixed undamped step (auto takes the
-# damped one for this cloth, compared below)
+# 625 particles: ten blocks of rows to share; the fixed undamped step
+# (auto takes the damped one for this cloth, compared below)
 for t in 1 2; do
     run 0 run "$SCENES/drape.yaml" -o drape$t --frames 9 --threads $t \
         --set 'cloths.0.grid.resolution=[24,24]' --set time.step_limit=undamped -q

@@ -151,12 +151,9 @@ static void sleeping_barrier(void)
 {
     MPI_Request request;
     MPI_Ibarrier(MPI_COMM_WORLD, &request);
-    for (int done = 0;;) {
-        MPI_Test(&request, &done, MPI_STATUS_IGNORE);
-        if (done)
-            break;
+    int done = 0;
+    while (MPI_Test(&request, &done, MPI_STATUS_IGNORE), !done)
         nanosleep(&(struct timespec){.tv_nsec = 2000000}, NULL);
-    }
 }
 
 static trajectory reference(const cs_scene *scene, int frames)
