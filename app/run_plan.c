@@ -54,6 +54,10 @@ void cs_run_print_plan(const cs_scene *scene, const cs_sim *sim, FILE *out)
         if (damped)
             fprintf(out, ": the step is chosen again before every outer step, smaller where "
                     "the cloth is stretched");
+        double reach, cap = cs_sim_script_step_cap(sim, &reach);
+        if (damped && isfinite(cap))
+            fprintf(out, ",\n    and at most %.6g s in frame 1, so that no scripted vertex moves "
+                    "more than %.3g mm a step", cap, 1e3 * reach);
         const char *why = cs_sim_step_limit_why(sim);
         if (why)
             fprintf(out, "\n    (the damped limit at rest is %.1f times the undamped one, "

@@ -42,6 +42,10 @@ typedef struct cs_script_state {
     bool released;
 } cs_script_state;
 
+/* motion.c: a bound on the speed of any point within r of the motion's
+ * centre at any time in [t0, t1]: |dc/dt| + |omega| r at its fastest */
+double cs_motion_max_speed(const cs_motion *m, double t0, double t1, double r);
+
 /* A script that step C held back runs at this multiple of its speed until
  * its clock is the simulation's again (scripts.c; runaway.c bounds it). */
 static const double CS_SCRIPT_CATCH_UP_RATE = 2.0;
@@ -130,6 +134,8 @@ struct cs_sim {
     double damped_dt;             /* the damped scheme's limit at rest (step_limit.c) */
     double undamped_dt;           /* 2 / omega_max, omega_max^2 by Lanczos */
     double gershgorin_dt;         /* the same from Gershgorin's bound (smaller) */
+    double script_reach;          /* how far a scripted vertex may move in a
+                                   * step at the damped limit (step_limit.c) */
     /* the damped limit's bisection (step_limit.c): the rows still in
      * question (-1: all) and each one's bound at the last step tried */
     int *bound_rows, nbound_rows, bound_capacity;
@@ -213,6 +219,10 @@ int cs_runaway_not_finite(cs_sim *sim, const double *v_next);
  * (collective: every rank calls it at the same point). */
 void cs_step_limit_init(cs_sim *sim);
 double cs_step_limit_now(cs_sim *sim);
+/* The step dt at the damped limit, capped for moving scripts: no longer
+ * than a step over [t0, t1] in which a scripted vertex moves script_reach,
+ * and never capped below dt_safety times the undamped limit */
+double cs_step_limit_scripts(const cs_sim *sim, double dt, double t0, double t1);
 
 /* scripts.c: the targets of scripted vertices at the end t1 of a step of
  * dt (script_x, script_v), at each script's own time t1 - lag */

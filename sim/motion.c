@@ -1,8 +1,9 @@
 /* motion.c: rigid motions over time (static, constant velocity, keyframes)
  * and the quaternion arithmetic they need. */
+#include <math.h>
 #include <string.h>
 
-#include "sim/sim.h"
+#include "sim/internal.h"
 #include "sim/vec3.h"
 
 void cs_quat_normalize(double q[4])
@@ -182,4 +183,26 @@ void cs_motion_pose(const cs_motion *m, double t, double R[9], double c[3],
         memcpy(velocity, vel, sizeof vel);
     if (omega)
         memcpy(omega, w, sizeof w);
+}
+
+/* The fastest point within r of the centre: |dc/dt| + |omega| r */
+static double motion_speed(const cs_motion *m, double t, double r)
+{
+    double c[3], vel[3], w[3];
+    cs_motion_pose(m, t, NULL, c, vel, w);
+    return cs_norm(vel) + cs_norm(w) * r;
+}
+
+double cs_motion_max_speed(const cs_motion *m, double t0, double t1, double r)
+{
+    if (m->kind != CS_MOTION_KEYFRAMES)
+        return motion_speed(m, t0 > -INFINITY ? t0 : 0.0, r); /* the same at every time */
+    /* keys are linear in position and slerped in rotation, so a segment's
+     * speed is the same at every time in it: its midpoint's */
+    double fastest = 0;
+    for (int k = 0; k + 1 < m->nkeys && m->keys[k].time < t1; k++)
+        if (m->keys[k + 1].time > t0)
+            fastest = fmax(fastest,
+                           motion_speed(m, 0.5 * (m->keys[k].time + m->keys[k + 1].time), r));
+    return fastest;
 }

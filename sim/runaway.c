@@ -48,37 +48,15 @@ void cs_runaway_init(cs_sim *sim)
     }
     sim->runaway.initial_speed = v0;
     sim->runaway.wave_speed = wave;
-    /* the extent of each script's vertices about its frame */
-    for (int s = 0; s < sim->nscripts; s++) {
-        cs_script_state *sc = sim->scripts + s;
-        sc->radius = 0;
-        for (int j = 0; j < sc->nvertices; j++)
-            sc->radius = fmax(sc->radius, cs_norm(sc->local + 3 * j));
-    }
     sim->runaway.stage = -1;
-}
-
-/* The fastest point within r of a rigid motion's centre at time t. */
-static double motion_speed(const cs_motion *m, double t, double r)
-{
-    double c[3], vel[3], w[3];
-    cs_motion_pose(m, t, NULL, c, vel, w);
-    return cs_norm(vel) + cs_norm(w) * r;
 }
 
 /* The fastest point within r of the motion's centre at any time up to t:
  * cloth keeps the speed a driver gave it after the driver stops (a twist
- * whose ends halt whips on), so the bound must not drop when the keys end.
- * Keys are linear in position and slerped in rotation, so a segment's
- * speed is its midpoint's. */
-static double motion_speed_so_far(const cs_motion *m, double t, double r)
+ * whose ends halt whips on), so the bound must not drop when the keys end. */
+static double speed_so_far(const cs_motion *m, double t, double r)
 {
-    double fastest = motion_speed(m, t, r);
-    if (m->kind == CS_MOTION_KEYFRAMES)
-        for (int k = 0; k + 1 < m->nkeys && m->keys[k].time < t; k++)
-            fastest = fmax(fastest,
-                           motion_speed(m, 0.5 * (m->keys[k].time + m->keys[k + 1].time), r));
-    return fastest;
+    return cs_motion_max_speed(m, -INFINITY, t, r);
 }
 
 double cs_runaway_limit(const cs_sim *sim, double t)
@@ -93,7 +71,7 @@ double cs_runaway_limit(const cs_sim *sim, double t)
      * keys ended while a held twist was still catching up. */
     for (int s = 0; s < sim->nscripts; s++) {
         double lag = sim->script_lag[s];
-        drive += motion_speed_so_far(&sim->scripts[s].motion, t - lag, sim->scripts[s].radius) *
+        drive += speed_so_far(&sim->scripts[s].motion, t - lag, sim->scripts[s].radius) *
                  (lag > 0 ? CS_SCRIPT_CATCH_UP_RATE : 1.0);
     }
     for (int b = 0; b < sim->nbodies; b++) {
@@ -111,7 +89,7 @@ double cs_runaway_limit(const cs_sim *sim, double t)
                 r = fmax(r, cs_norm(d));
             }
         }
-        drive += motion_speed_so_far(&body->motion, t, r);
+        drive += speed_so_far(&body->motion, t, r);
     }
     return SPEED_FACTOR * drive + RELEASED_STRAIN * sim->runaway.wave_speed + SPEED_FLOOR;
 }

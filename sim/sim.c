@@ -334,6 +334,7 @@ int cs_sim_create_checked(const cs_sim_def *def, cs_sim **out, char *err, size_t
                     sim->script_of[g] = s;
                     cs_sub(sim->x + 3 * g, c0, rel);
                     cs_mat_apply_transpose(dst->rotation0, rel, dst->local + 3 * j);
+                    dst->radius = fmax(dst->radius, cs_norm(dst->local + 3 * j));
                     sim->is_free[g] = 0;
                 }
             }
@@ -395,6 +396,8 @@ int cs_sim_create_checked(const cs_sim_def *def, cs_sim **out, char *err, size_t
     cs_scripts_hold_releasable(sim, true);
     double frame = 1.0 / def->fps;
     double dt_max = def->dt > 0 ? def->dt : def->dt_safety * sim->stable_dt;
+    if (!(def->dt > 0) && sim->step_limit == CS_STEP_DAMPED)
+        dt_max = cs_step_limit_scripts(sim, dt_max, sim->t, sim->t + frame);
     if (dt_max > frame)
         dt_max = frame;
     double steps = ceil(frame / dt_max - 1e-9); /* a double: 1/fps over 1e-308 fits */
@@ -498,6 +501,12 @@ double cs_sim_undamped_dt(const cs_sim *sim) { return sim->undamped_dt; }
 double cs_sim_damped_dt(const cs_sim *sim) { return sim->damped_dt; }
 cs_step_limit cs_sim_step_limit(const cs_sim *sim) { return sim->step_limit; }
 const char *cs_sim_step_limit_why(const cs_sim *sim) { return sim->step_limit_why; }
+double cs_sim_script_step_cap(const cs_sim *sim, double *reach)
+{
+    if (reach)
+        *reach = sim->script_reach;
+    return cs_step_limit_scripts(sim, INFINITY, 0.0, 1.0 / sim->def.fps);
+}
 double cs_sim_gershgorin_dt(const cs_sim *sim) { return sim->gershgorin_dt; }
 int cs_sim_particle_count(const cs_sim *sim) { return sim->n; }
 int cs_sim_spring_count(const cs_sim *sim) { return sim->nsprings; }

@@ -492,6 +492,11 @@ cs_step_limit cs_sim_step_limit(const cs_sim *sim);
 /* what decided step_limit auto's choice, a phrase (NULL when the
  * definition named the limit itself) */
 const char *cs_sim_step_limit_why(const cs_sim *sim);
+/* at the damped limit, the longest step in the first frame in which a
+ * scripted vertex moves its script reach (a quarter of the repulsion
+ * thickness; never below the undamped step), and that reach in metres;
+ * INFINITY when no script moves then */
+double cs_sim_script_step_cap(const cs_sim *sim, double *reach);
 double cs_sim_undamped_dt(const cs_sim *sim);
 double cs_sim_gershgorin_dt(const cs_sim *sim);
 int cs_sim_particle_count(const cs_sim *sim);

@@ -224,12 +224,14 @@ static bool adaptive_step(const cs_sim *sim)
 
 /* The step for the rest of a frame: the frame's remaining time in equal
  * steps no longer than dt_safety times the stability limit at the current
- * positions (or the scene's fixed step). Returns the number of steps. */
+ * positions and the moving scripts' cap (or the scene's fixed step).
+ * Returns the number of steps. */
 static long steps_for(cs_sim *sim, double remaining)
 {
     if (!adaptive_step(sim)) /* fixed: the step set at creation */
         return lround(remaining / sim->dt);
-    double dt_max = sim->def.dt_safety * cs_step_limit_now(sim);
+    double dt_max = cs_step_limit_scripts(sim, sim->def.dt_safety * cs_step_limit_now(sim),
+                                          sim->t, sim->t + remaining);
     double steps = ceil(remaining / fmin(dt_max, remaining) - 1e-9);
     if (!(steps >= 1))
         steps = 1;

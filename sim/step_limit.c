@@ -104,6 +104,47 @@ static double largest_step(cs_sim *sim, step_bound_fn bound, double lo, double h
     return lo;
 }
 
+/* At the damped limit a scripted vertex moves at most this fraction of
+ * script_length in a step. Uncapped, the damped step closed the pinch
+ * between scripted plates (tests/data/scenes/pinch.yaml) by 6 thicknesses
+ * a step, more than step C's zones could resolve: the run stopped with a
+ * script conflict in frame 1, as it did at 1; at 0.5 and 0.25 it stays
+ * intersection free with the plates on their keys (the undamped step moved
+ * them 0.09 thickness). The half-million-triangle twist (ends at 1.7 m/s,
+ * thickness 0.4 mm) gets a step of 6.0e-5 s at rest, 18 times its undamped one. */
+static const double SCRIPT_STEP_FRACTION = 0.25;
+
+/* The length a scripted vertex's step is measured against: the repulsion
+ * thickness with self-collisions (what step A's pairs and step C's zones
+ * resolve), else the shortest edge (what the springs resolve). */
+static double script_length(const cs_sim *sim)
+{
+    double len = sim->def.self_collision ? sim->def.self.thickness : INFINITY;
+    const cs_springs *s = &sim->springs;
+    for (int k = 0; k < s->nedge; k++)
+        len = fmin(len, s->rest_length[k]);
+    return len;
+}
+
+double cs_step_limit_scripts(const cs_sim *sim, double dt, double t0, double t1)
+{
+    double fastest = 0;
+    for (int s = 0; s < sim->nscripts; s++) {
+        const cs_script_state *sc = sim->scripts + s;
+        if (sc->released)
+            continue;
+        /* a script behind its keys runs on its own clock, faster (scripts.c) */
+        double lag = sim->script_lag ? sim->script_lag[s] : 0;
+        fastest = fmax(fastest, cs_motion_max_speed(&sc->motion, t0 - lag, t1, sc->radius) *
+                                    (lag > 0 ? CS_SCRIPT_CATCH_UP_RATE : 1.0));
+    }
+    /* the undamped step is the floor, as for the damped limit itself: it
+     * was the step for every scripted scene before the cap, and on the
+     * 32 x 16 twist it moves the ends half a thickness a step, resolved */
+    double cap = fastest > 0 ? sim->script_reach / fastest : INFINITY;
+    return cap < dt ? fmax(cap, sim->def.dt_safety * sim->undamped_dt) : dt;
+}
+
 static bool moving_scripts(const cs_sim *sim)
 {
     for (int s = 0; s < sim->nscripts; s++)
@@ -113,15 +154,16 @@ static bool moving_scripts(const cs_sim *sim)
 }
 
 /* auto's choice. Two kinds of scene keep the undamped step whatever the
- * gain, because the larger step breaks what they rely on: vertices moved by
- * a script (a pinch between scripted plates closes more per step than step
- * C's zones can resolve) and the projection friction method (at the damped
- * step the rolling cloth sinks 4.5 mm into the incline, against under 1 mm
- * at the undamped one). */
+ * gain, because a larger step breaks them: scripts that step C may hold
+ * (script_zones: hold; the slot scene's held drag blows up in step C at
+ * 1.4 times the undamped step already, at either limit) and the projection
+ * friction method (at the damped step the rolling cloth sinks 4.5 mm into
+ * the incline, against under 1 mm at the undamped one). */
 static bool auto_takes_damped(cs_sim *sim)
 {
-    if (moving_scripts(sim)) {
-        sim->step_limit_why = "vertices moved by a script keep the undamped step";
+    if (moving_scripts(sim) && sim->def.self_collision &&
+        sim->def.self.script_zones == CS_SCRIPT_ZONES_HOLD) {
+        sim->step_limit_why = "scripts that step C may hold keep the undamped step";
         return false;
     }
     if (sim->def.friction_method != CS_FRICTION_IMPROVED) {
@@ -143,6 +185,7 @@ void cs_step_limit_init(cs_sim *sim)
     if (!(lambda > 0) || lambda > bound)
         lambda = bound; /* Lanczos out of memory: Gershgorin's bound */
     sim->gershgorin_dt = bound > 0 ? 2.0 / sqrt(bound) : INFINITY;
+    sim->script_reach = SCRIPT_STEP_FRACTION * script_length(sim);
     sim->undamped_dt = lambda > 0 ? 2.0 / sqrt(lambda) : INFINITY;
     /* Gershgorin's undamped step passes the damped test too (each term is
      * at most dt^2 k): the bracket's lower end */

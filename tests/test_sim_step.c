@@ -243,6 +243,35 @@ static void test_impossible_steps_are_refused(void **state)
     cs_trimesh_destroy(mesh);
 }
 
+/* An n x n sheet of 1 m, no gravity, whose corners 0 and n a script
+ * moves dx along x from t = 0 to t1, then holds (self-collisions of
+ * thickness h when h > 0); *mesh must outlive the sim. */
+static cs_sim *dragged_sheet(int n, double dx, double t1, double h, cs_trimesh **mesh)
+{
+    double size[2] = {1, 1}, q[4] = {1, 0, 0, 0}, c[3] = {0, 0, 0};
+    int res[2] = {n, n}, corners[2] = {0, n};
+    cs_keyframe keys[2] = {{0, {0, 0, 0}, {1, 0, 0, 0}}, {t1, {dx, 0, 0}, {1, 0, 0, 0}}};
+    cs_motion motion = cs_motion_static();
+    motion.kind = CS_MOTION_KEYFRAMES;
+    motion.nkeys = 2;
+    motion.keys = keys;
+    cs_vertex_script drag = {2, corners, motion, 0};
+    *mesh = cs_trimesh_create_grid(size, res, q, c);
+    cs_cloth_def cloth = {.name = "c", .mesh = *mesh, .material = cs_default_cloth_material(),
+                          .nscripts = dx != 0 ? 1 : 0, .scripts = &drag};
+    cs_sim_def def = cs_default_sim_def();
+    def.ncloths = 1;
+    def.cloths = &cloth;
+    def.gravity[0] = def.gravity[1] = def.gravity[2] = 0;
+    def.self_collision = h > 0;
+    if (h > 0)
+        def.self.thickness = h;
+    char err[512];
+    cs_sim *sim = NULL;
+    assert_int_equal(cs_sim_create_checked(&def, &sim, err, sizeof err), CS_OK);
+    return sim;
+}
+
 /* The runaway bound follows what drives the cloth: cloth keeps the speed a
  * script gave it after the script stops, and a script step C held back
  * catches up at twice its speed. A twist whose ends stop at their last key
@@ -252,26 +281,9 @@ static void test_impossible_steps_are_refused(void **state)
 static void test_runaway_bound_keeps_what_scripts_gave(void **state)
 {
     (void)state;
-    double size[2] = {1, 1}, q[4] = {1, 0, 0, 0}, c[3] = {0, 0, 0};
-    int res[2] = {4, 4};
-    int corners[2] = {0, 4};
-    /* the pinned corners move 1 m along x in 0.5 s (2 m/s), then stop */
-    cs_keyframe keys[2] = {{0, {0, 0, 0}, {1, 0, 0, 0}}, {0.5, {1, 0, 0}, {1, 0, 0, 0}}};
-    cs_motion motion = cs_motion_static();
-    motion.kind = CS_MOTION_KEYFRAMES;
-    motion.nkeys = 2;
-    motion.keys = keys;
-    cs_vertex_script pin = {2, corners, motion, 0};
-    cs_trimesh *mesh = cs_trimesh_create_grid(size, res, q, c);
-    cs_cloth_def cloth = {.name = "c", .mesh = mesh, .material = cs_default_cloth_material(),
-                          .nscripts = 1, .scripts = &pin};
-    cs_sim_def def = cs_default_sim_def();
-    def.ncloths = 1;
-    def.cloths = &cloth;
-    def.gravity[0] = def.gravity[1] = def.gravity[2] = 0;
-    char err[512];
-    cs_sim *sim = NULL;
-    assert_int_equal(cs_sim_create_checked(&def, &sim, err, sizeof err), CS_OK);
+    /* the scripted corners move 1 m along x in 0.5 s (2 m/s), then stop */
+    cs_trimesh *mesh;
+    cs_sim *sim = dragged_sheet(4, 1, 0.5, 0, &mesh);
     /* at t = 0 the script has not moved yet (a motion is still before its
      * first key): the terms without it */
     double still = cs_runaway_limit(sim, 0);
@@ -286,6 +298,52 @@ static void test_runaway_bound_keeps_what_scripts_gave(void **state)
     assert_true(fabs(cs_runaway_limit(sim, 0.6) - (still + 40)) < 1e-9);
     cs_sim_destroy(sim);
     cs_trimesh_destroy(mesh);
+}
+
+/* The first frame's step of an 8 x 8 sheet dragged at v by two corners
+ * (still for v = 0), and its limits and script reach */
+static double dragged_sheet_step(double v, double *undamped, double *damped, double *reach)
+{
+    cs_trimesh *mesh;
+    cs_sim *sim = dragged_sheet(8, v, 1.0, 0.004, &mesh);
+    assert_int_equal(cs_sim_step_limit(sim), CS_STEP_DAMPED);
+    cs_sim_def def = cs_default_sim_def();
+    *undamped = def.dt_safety * cs_sim_undamped_dt(sim);
+    *damped = def.dt_safety * cs_sim_damped_dt(sim);
+    cs_sim_script_step_cap(sim, reach);
+    double dt = cs_sim_dt(sim);
+    cs_sim_destroy(sim);
+    cs_trimesh_destroy(mesh);
+    return dt;
+}
+
+/* The frame of 1/24 s in equal steps of at most dt */
+static double frame_step(double dt)
+{
+    double frame = 1.0 / 24;
+    return frame / ceil(frame / dt - 1e-9);
+}
+
+/* At the damped limit a moving script caps the step so that its vertices
+ * move at most a quarter of the repulsion thickness a step: for a
+ * translation at v, dt = (h / 4) / v. The cap never goes below the
+ * undamped step, and a sheet without scripts keeps the damped limit. */
+static void test_moving_script_caps_the_damped_step(void **state)
+{
+    (void)state;
+    double undamped, damped, reach;
+    double still = dragged_sheet_step(0, &undamped, &damped, &reach);
+    assert_true(damped > 8 * undamped); /* room for a cap between them */
+    assert_true(fabs(still - frame_step(damped)) < 1e-12);
+    /* a cap halfway (in log) between the two limits */
+    double cap = sqrt(undamped * damped), v = 0.001 / cap;
+    double capped = dragged_sheet_step(v, &undamped, &damped, &reach);
+    assert_true(fabs(reach - 0.001) < 1e-15);
+    assert_true(fabs(capped - frame_step(cap)) < 1e-12 * cap);
+    assert_true(capped < 0.5 * frame_step(damped));
+    /* ten times faster than the undamped step allows: the undamped step */
+    double fast = dragged_sheet_step(10 * 0.001 / undamped, &undamped, &damped, &reach);
+    assert_true(fabs(fast - frame_step(undamped)) < 1e-12 * undamped);
 }
 
 /* Far past the stability limit the explicit elastic forces grow
@@ -540,6 +598,7 @@ int main(void)
         cmocka_unit_test(test_runaway_is_detected_with_its_stage),
         cmocka_unit_test(test_runaway_waits_for_b7_at_contacts),
         cmocka_unit_test(test_runaway_bound_keeps_what_scripts_gave),
+        cmocka_unit_test(test_moving_script_caps_the_damped_step),
         cmocka_unit_test(test_wind_drag_terminal_velocity),
         cmocka_unit_test(test_moving_body_drags_particle),
         cmocka_unit_test(test_scripted_vertices_follow_keys),
