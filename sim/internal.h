@@ -219,10 +219,11 @@ int cs_runaway_not_finite(cs_sim *sim, const double *v_next);
  * (collective: every rank calls it at the same point). */
 void cs_step_limit_init(cs_sim *sim);
 double cs_step_limit_now(cs_sim *sim);
-/* The step dt at the damped limit, capped for moving scripts: no longer
- * than a step over [t0, t1] in which a scripted vertex moves script_reach,
- * and never capped below dt_safety times the undamped limit */
-double cs_step_limit_scripts(const cs_sim *sim, double dt, double t0, double t1);
+/* The moving scripts' cap on the damped limit's step: the step in which a
+ * scripted vertex moves script_reach at the scripts' fastest over (t0,
+ * t1), but never below dt_safety times the undamped limit; INFINITY when
+ * no script moves then */
+double cs_step_limit_scripts(const cs_sim *sim, double t0, double t1);
 
 /* scripts.c: the targets of scripted vertices at the end t1 of a step of
  * dt (script_x, script_v), at each script's own time t1 - lag */

@@ -397,7 +397,7 @@ int cs_sim_create_checked(const cs_sim_def *def, cs_sim **out, char *err, size_t
     double frame = 1.0 / def->fps;
     double dt_max = def->dt > 0 ? def->dt : def->dt_safety * sim->stable_dt;
     if (!(def->dt > 0) && sim->step_limit == CS_STEP_DAMPED)
-        dt_max = cs_step_limit_scripts(sim, dt_max, sim->t, sim->t + frame);
+        dt_max = fmin(dt_max, cs_step_limit_scripts(sim, sim->t, sim->t + frame));
     if (dt_max > frame)
         dt_max = frame;
     double steps = ceil(frame / dt_max - 1e-9); /* a double: 1/fps over 1e-308 fits */
@@ -505,7 +505,7 @@ double cs_sim_script_step_cap(const cs_sim *sim, double *reach)
 {
     if (reach)
         *reach = sim->script_reach;
-    return cs_step_limit_scripts(sim, INFINITY, 0.0, 1.0 / sim->def.fps);
+    return cs_step_limit_scripts(sim, 0.0, 1.0 / sim->def.fps);
 }
 double cs_sim_gershgorin_dt(const cs_sim *sim) { return sim->gershgorin_dt; }
 int cs_sim_particle_count(const cs_sim *sim) { return sim->n; }

@@ -230,8 +230,13 @@ static long steps_for(cs_sim *sim, double remaining)
 {
     if (!adaptive_step(sim)) /* fixed: the step set at creation */
         return lround(remaining / sim->dt);
-    double dt_max = cs_step_limit_scripts(sim, sim->def.dt_safety * cs_step_limit_now(sim),
-                                          sim->t, sim->t + remaining);
+    /* a cap at the undamped step needs no damped limit, which is never
+     * below it (the 32 x 16 twist: the bound's passes before each outer
+     * step made it 14% slower for the same steps) */
+    double floor_dt = sim->def.dt_safety * sim->undamped_dt;
+    double dt_max = cs_step_limit_scripts(sim, sim->t, sim->t + remaining);
+    if (dt_max > floor_dt)
+        dt_max = fmin(dt_max, sim->def.dt_safety * cs_step_limit_now(sim));
     double steps = ceil(remaining / fmin(dt_max, remaining) - 1e-9);
     if (!(steps >= 1))
         steps = 1;

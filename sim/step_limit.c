@@ -126,7 +126,7 @@ static double script_length(const cs_sim *sim)
     return len;
 }
 
-double cs_step_limit_scripts(const cs_sim *sim, double dt, double t0, double t1)
+double cs_step_limit_scripts(const cs_sim *sim, double t0, double t1)
 {
     double fastest = 0;
     for (int s = 0; s < sim->nscripts; s++) {
@@ -141,8 +141,8 @@ double cs_step_limit_scripts(const cs_sim *sim, double dt, double t0, double t1)
     /* the undamped step is the floor, as for the damped limit itself: it
      * was the step for every scripted scene before the cap, and on the
      * 32 x 16 twist it moves the ends half a thickness a step, resolved */
-    double cap = fastest > 0 ? sim->script_reach / fastest : INFINITY;
-    return cap < dt ? fmax(cap, sim->def.dt_safety * sim->undamped_dt) : dt;
+    return fastest > 0 ? fmax(sim->script_reach / fastest, sim->def.dt_safety * sim->undamped_dt)
+                       : INFINITY;
 }
 
 static bool moving_scripts(const cs_sim *sim)
