@@ -15,6 +15,8 @@ Three measurements, each a plain `clothsim run` at the scene's defaults
                   --set self_collision.thickness=0.0004 --frames 40
               (hours on 2 cores; not committed, a few GB) and given with
               --twist-state out/twist_500k. Without it the twist is skipped.
+  twist0      the same twist's first frame from rest (--only twist0, not run
+              by default: about 11 minutes a run on 2 cores)
 
 For each: seconds per frame, steps and CG iterations per step, peak
 memory, and the largest count of intersecting triangle pairs at a frame's
@@ -23,7 +25,7 @@ end (the verifier's, in frames.jsonl; must be 0). Then CG alone
 STREAM triad measured in the same run: the bytes one CG iteration streams
 (model below) over its time, as a fraction of the triad's bandwidth.
 
-usage: bench/paper_scale.py [--build DIR] [--repeat N] [--only drape20k,drape80k,twist,cg]
+usage: bench/paper_scale.py [--build DIR] [--repeat N] [--only drape20k,drape80k,twist,twist0,cg]
                             [--twist-state DIR] [--out DIR]
 Writes DIR/paper_scale.md (default out/paper_scale). A Release build is expected.
 """
@@ -84,6 +86,23 @@ def drape(exe, n, thickness, repeat, out):
     return case_row("drape %dx%d (%d triangles)" % (n, n, 2 * n * n), runs, frames)
 
 
+TWIST = os.path.join(ROOT, "scenes", "figures", "twist.yaml")
+TWIST_500K = ["--set", "cloths.0.grid.resolution=[1000,250]",
+              "--set", "self_collision.thickness=0.0004"]
+
+
+def twist_from_rest(exe, repeat, out):
+    runs = []
+    for k in range(repeat):
+        d = os.path.join(out, "twist_rest")
+        wall, rss, _ = timed_run([exe, "run", TWIST, "-q", "--frames", "1", "-o", d] + TWIST_500K,
+                                 d + "_log")
+        runs.append((wall, rss, records(d)))
+        print("  twist from rest, run %d: %.1f s/frame" % (k + 1, wall), file=sys.stderr,
+              flush=True)
+    return case_row("twist (501,000 triangles), frame 1 from rest", runs, 1)
+
+
 def twist(exe, state, repeat, out):
     done = max(r["frame"] for r in records(state))
     runs = []
@@ -137,7 +156,7 @@ def main():
     if a.repeat < 1:
         die("--repeat must be >= 1")
     only = set(a.only.split(","))
-    unknown = only - {"drape20k", "drape80k", "twist", "cg"}
+    unknown = only - {"drape20k", "drape80k", "twist", "twist0", "cg"}
     if unknown:
         die("--only: unknown %s" % ", ".join(sorted(unknown)))
     if "twist" in only and a.twist_state and not os.path.isfile(
@@ -150,6 +169,8 @@ def main():
         rows.append(drape(exe, 100, 0, a.repeat, a.out))
     if "drape80k" in only:
         rows.append(drape(exe, 200, 0.002, a.repeat, a.out))
+    if "twist0" in only:
+        rows.append(twist_from_rest(exe, a.repeat, a.out))
     if "twist" in only:
         if a.twist_state:
             rows.append(twist(exe, a.twist_state, a.repeat, a.out))
