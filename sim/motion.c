@@ -196,7 +196,7 @@ static double motion_speed(const cs_motion *m, double t, double r)
 double cs_motion_max_speed(const cs_motion *m, double t0, double t1, double r)
 {
     if (m->kind != CS_MOTION_KEYFRAMES)
-        return motion_speed(m, t0 > -INFINITY ? t0 : 0.0, r); /* the same at every time */
+        return motion_speed(m, 0.0, r); /* static or constant: the same at every time */
     /* keys are linear in position and slerped in rotation, so a segment's
      * speed is the same at every time in it: its midpoint's */
     double fastest = 0;
