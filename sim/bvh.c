@@ -175,11 +175,19 @@ static inline bool share_vertex(const cs_bvh *A, int a, const cs_bvh *B, int b)
 static void leaf_pairs(traversal *tr, int i, int j)
 {
     const cs_bvh *A = tr->A, *B = tr->B;
-    for (int ka = A->first[i]; ka < A->first[i] + A->count[i]; ka++) {
+    /* the bounds in locals: push_pair's stores could alias them, so the
+     * compiler reloaded them at every test */
+    const int ka_end = A->first[i] + A->count[i], kb_end = B->first[j] + B->count[j];
+    const cs_box *node_b = B->box + j;
+    for (int ka = A->first[i]; ka < ka_end; ka++) {
         int a = A->order[ka];
         const cs_box *ba = A->leaf_box + ka;
+        /* most leaf pairs' primitives miss each other: one test against
+         * the other leaf's box spares the primitives' tests */
+        if (!cs_box_overlap_branchless(ba, node_b))
+            continue;
         int kb0 = (tr->self && i == j) ? ka + 1 : B->first[j];
-        for (int kb = kb0; kb < B->first[j] + B->count[j]; kb++) {
+        for (int kb = kb0; kb < kb_end; kb++) {
             if (!cs_box_overlap_branchless(ba, B->leaf_box + kb))
                 continue;
             int b = B->order[kb];
