@@ -175,8 +175,7 @@ static inline bool share_vertex(const cs_bvh *A, int a, const cs_bvh *B, int b)
 static void leaf_pairs(traversal *tr, int i, int j)
 {
     const cs_bvh *A = tr->A, *B = tr->B;
-    /* the bounds in locals: push_pair's stores could alias them, so the
-     * compiler reloaded them at every test */
+    /* the bounds in locals: push_pair's stores may alias the tree's arrays */
     const int ka_end = A->first[i] + A->count[i], kb_end = B->first[j] + B->count[j];
     const cs_box *node_b = B->box + j;
     for (int ka = A->first[i]; ka < ka_end; ka++) {

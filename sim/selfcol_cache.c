@@ -66,6 +66,7 @@ enum { CACHE_FORECAST_AFTER = 3 };
  * On the 100 x 100 benchmark sheet it halves the candidates; the lists do
  * not depend on the boxes, so the frames are the same bits. */
 enum { CACHE_TIGHT_SERVED = 2 };
+_Static_assert((int)CACHE_FORECAST_AFTER > (int)CACHE_TIGHT_SERVED, "a cache that forecasts is never tight");
 
 static void centroid(const cs_selfcol *sc, double c[3])
 {
@@ -195,7 +196,7 @@ static int rebuild(cs_selfcol *sc, int rank, double thickness, const double anch
     cs_pair_cache *c = &sc->cache;
     bool tight = c->valid && c->served <= CACHE_TIGHT_SERVED;
     double slack = tight ? 0 : fmax(c->slack, 0) * thickness;
-    bool forecast = !tight && c->valid && c->served >= CACHE_FORECAST_AFTER;
+    bool forecast = c->valid && c->served >= CACHE_FORECAST_AFTER; /* never tight */
     /* room for step A's boxes (half the thickness around x_free, more for
      * particles moving relative to the rest) whichever search rebuilds */
 #pragma omp parallel for schedule(static)
