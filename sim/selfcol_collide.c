@@ -543,8 +543,9 @@ static bool collision_respond(cs_selfcol *sc, const cs_pair *p, bool is_edge, do
         return true;
     double un = sc_pair_normal_velocity(p, c, u, nrm, rel);
     if (un < 0) {
-        sc_pair_impulse(sc, p, c, -un / inv_m, nrm, u);
-        sc_pair_impulse(sc, p, c, -un / inv_m, nrm, dv);
+        double J = -un / sc_pair_impulse_inverse_mass(sc, p, c, inv_m);
+        sc_pair_impulse(sc, p, c, J, nrm, u);
+        sc_pair_impulse(sc, p, c, J, nrm, dv);
     }
     for (int q = 0; q < 4; q++) {
         int i = p->v[q];

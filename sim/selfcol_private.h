@@ -28,6 +28,11 @@ int sc_distribute_boundary(cs_sim *sim, cs_pair_list *pt, cs_pair_list *ee);
 void sc_pair_impulse(const cs_selfcol *sc, const cs_pair *p, const double c[4], double J,
                      const double dir[3], double *v);
 double sc_pair_inverse_mass(const cs_selfcol *sc, const cs_pair *p, const double c[4]);
+/* What an impulse on the pair's relative motion divides by: its inverse
+ * mass, raised where one vertex would take more than SC_MAX_LEVERAGE
+ * times the change of the relative velocity (see selfcol_response.c) */
+double sc_pair_impulse_inverse_mass(const cs_selfcol *sc, const cs_pair *p, const double c[4],
+                                    double inv_m);
 double sc_pair_normal_velocity(const cs_pair *p, const double c[4], const double *v,
                                const double n[3], double rel[3]);
 bool sc_pair_respond(const cs_selfcol *sc, const cs_pair *p, bool is_edge, const double *x,

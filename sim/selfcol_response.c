@@ -74,6 +74,26 @@ double sc_pair_inverse_mass(const cs_selfcol *sc, const cs_pair *p, const double
     return s;
 }
 
+/* An impulse J on the pair's relative motion changes vertex k's velocity
+ * by c_k J / m_k and the relative velocity by J inv_m, so vertex k moves
+ * |c_k| / (m_k inv_m) times the relative change: at most 1 when the four
+ * are free and of one mass, but 1 / |c_k| when the others are held (pins,
+ * scripts) or far heavier. Stopping an approach at an edge's held end
+ * through a free vertex of weight 1e-8 gave that vertex 8e14 m/s. Past
+ * SC_MAX_LEVERAGE the impulse stops only part of the approach: later
+ * passes and, in step C, impact zones do the rest, as for any pair that
+ * its impulses cannot separate. */
+#define SC_MAX_LEVERAGE 4.0
+
+double sc_pair_impulse_inverse_mass(const cs_selfcol *sc, const cs_pair *p, const double c[4],
+                                    double inv_m)
+{
+    double lever = 0;
+    for (int k = 0; k < 4; k++)
+        lever = fmax(lever, fabs(c[k]) * sc->inv_mass[p->v[k]]);
+    return fmax(inv_m, lever / SC_MAX_LEVERAGE);
+}
+
 double sc_pair_normal_velocity(const cs_pair *p, const double c[4], const double *v,
                                const double n[3], double rel[3])
 {
@@ -175,16 +195,16 @@ bool sc_pair_respond(const cs_selfcol *sc, const cs_pair *p, bool is_edge, const
     double inv_m = sc_pair_inverse_mass(sc, p, c);
     if (!(inv_m > 0))
         return false;
-    double rel[3];
+    double inv_j = sc_pair_impulse_inverse_mass(sc, p, c, inv_m), rel[3];
     double vn = sc_pair_normal_velocity(p, c, v, n, rel), dvn = 0;
     if (r->inelastic && vn < 0) {
-        sc_pair_impulse(sc, p, c, -vn / inv_m, n, v);
-        dvn = -vn;
-        vn = 0;
+        sc_pair_impulse(sc, p, c, -vn / inv_j, n, v);
+        dvn = -vn * (inv_m / inv_j);
+        vn += dvn;
     }
     if (r->elastic) {
         double d = r->thickness - sd;
-        double J = fmin(r->dt * r->k * d, (REPULSION_CLOSING * d / r->dt - vn) / inv_m);
+        double J = fmin(r->dt * r->k * d, (REPULSION_CLOSING * d / r->dt - vn) / inv_j);
         if (J > 0) {
             sc_pair_impulse(sc, p, c, J, n, v);
             dvn += J * inv_m;
@@ -198,7 +218,7 @@ bool sc_pair_respond(const cs_selfcol *sc, const cs_pair *p, bool is_edge, const
         if (speed > 0) {
             double drop = fmin(r->mu * dvn, speed);
             double dir[3] = {vt[0] / speed, vt[1] / speed, vt[2] / speed};
-            sc_pair_impulse(sc, p, c, -drop / inv_m, dir, v);
+            sc_pair_impulse(sc, p, c, -drop / inv_j, dir, v);
         }
     }
     return true;
