@@ -145,27 +145,12 @@ double cs_step_limit_scripts(const cs_sim *sim, double t0, double t1)
                        : INFINITY;
 }
 
-static bool moving_scripts(const cs_sim *sim)
-{
-    for (int s = 0; s < sim->nscripts; s++)
-        if (sim->scripts[s].motion.kind != CS_MOTION_STATIC)
-            return true;
-    return false;
-}
-
-/* auto's choice. Two kinds of scene keep the undamped step whatever the
- * gain, because a larger step breaks them: scripts that step C may hold
- * (script_zones: hold; the slot scene's held drag blows up in step C at
- * 1.4 times the undamped step already, at either limit) and the projection
- * friction method (at the damped step the rolling cloth sinks 4.5 mm into
- * the incline, against under 1 mm at the undamped one). */
+/* auto's choice. The projection friction method keeps the undamped step
+ * whatever the gain, because the larger step breaks it: at the damped step
+ * the rolling cloth sinks 4.5 mm into the incline, against under 1 mm at
+ * the undamped one. */
 static bool auto_takes_damped(cs_sim *sim)
 {
-    if (moving_scripts(sim) && sim->def.self_collision &&
-        sim->def.self.script_zones == CS_SCRIPT_ZONES_HOLD) {
-        sim->step_limit_why = "scripts that step C may hold keep the undamped step";
-        return false;
-    }
     if (sim->def.friction_method != CS_FRICTION_IMPROVED) {
         sim->step_limit_why = "the projection friction method keeps the undamped step";
         return false;
