@@ -5,6 +5,8 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include <omp.h>
+
 #include "sim/bvh.h"
 
 enum { LEAF_SIZE = 4 };
@@ -287,31 +289,50 @@ int cs_bvh_collect(const cs_bvh *A, const cs_bvh *B, int rank, cs_bvh_work *w,
     descend(&plan, 0, 0, 0);
     if (plan.failed)
         return -1;
-    if (w->ntasks > w->found_capacity) {
-        cs_index_pairs *f = realloc(w->found, sizeof *f * (size_t)w->ntasks);
+    /* A list per task kept its own capacity from call to call: over a
+     * landing most of the 4^TASK_DEPTH task slots came to hold a buffer,
+     * 40% of the 20k drape's heap. One list per thread holds only what
+     * that thread found, and each task's place in it. */
+    if (w->ntasks > w->task_slots) {
+        int *f = realloc(w->task_first, sizeof *f * 3 * (size_t)w->ntasks);
         if (!f)
             return -1;
-        memset(f + w->found_capacity, 0, sizeof *f * (size_t)(w->ntasks - w->found_capacity));
+        w->task_first = f;
+        w->task_slots = w->ntasks;
+    }
+    int nthreads = omp_get_max_threads();
+    if (nthreads > w->nthreads) {
+        cs_index_pairs *f = realloc(w->found, sizeof *f * (size_t)nthreads);
+        if (!f)
+            return -1;
+        memset(f + w->nthreads, 0, sizeof *f * (size_t)(nthreads - w->nthreads));
         w->found = f;
-        w->found_capacity = w->ntasks;
+        w->nthreads = nthreads;
     }
     int failed = 0;
-#pragma omp parallel for schedule(dynamic, 1) reduction(| : failed)
-    for (int t = 0; t < w->ntasks; t++) {
-        /* the task's list filled in a copy on this thread's stack: the
-         * tasks' lists lie side by side, four to a cache line, and two
-         * threads pushing onto neighbours passed that line back and forth
-         * at every pair, a large share of the traversal's time */
-        cs_index_pairs found = w->found[t];
+#pragma omp parallel reduction(| : failed)
+    {
+        /* the thread's list filled in a copy on its stack: lists side by
+         * side in w->found share cache lines, and two threads pushing onto
+         * neighbours passed a line back and forth at every pair */
+        int me = omp_get_thread_num();
+        cs_index_pairs found = w->found[me];
         found.n = 0;
-        traversal tr = {A, B, A == B, rank, 0, NULL, &found, 0};
-        descend(&tr, w->task[2 * t], w->task[2 * t + 1], 0);
-        w->found[t] = found;
-        failed |= tr.failed;
+#pragma omp for schedule(dynamic, 1)
+        for (int t = 0; t < w->ntasks; t++) {
+            int first = found.n;
+            traversal tr = {A, B, A == B, rank, 0, NULL, &found, 0};
+            descend(&tr, w->task[2 * t], w->task[2 * t + 1], 0);
+            w->task_first[3 * t] = first;
+            w->task_first[3 * t + 1] = found.n - first;
+            w->task_first[3 * t + 2] = me;
+            failed |= tr.failed;
+        }
+        w->found[me] = found;
     }
     long total = 0;
     for (int t = 0; t < w->ntasks; t++)
-        total += w->found[t].n;
+        total += w->task_first[3 * t + 1];
     if (failed || total > INT_MAX / 2)
         return -1;
     if (total > out->capacity) {
@@ -322,19 +343,22 @@ int cs_bvh_collect(const cs_bvh *A, const cs_bvh *B, int rank, cs_bvh_work *w,
         out->capacity = (int)total;
     }
     for (int t = 0; t < w->ntasks; t++) { /* task order: the depth-first order */
-        if (w->found[t].n > 0)
-            memcpy(out->ab + 2 * (size_t)out->n, w->found[t].ab, sizeof *out->ab * 2 * (size_t)w->found[t].n);
-        out->n += w->found[t].n;
+        const int *f = w->task_first + 3 * t;
+        if (f[1] > 0)
+            memcpy(out->ab + 2 * (size_t)out->n, w->found[f[2]].ab + 2 * (size_t)f[0],
+                   sizeof *out->ab * 2 * (size_t)f[1]);
+        out->n += f[1];
     }
     return 0;
 }
 
 void cs_bvh_work_free(cs_bvh_work *w)
 {
-    for (int t = 0; t < w->found_capacity; t++)
+    for (int t = 0; t < w->nthreads; t++)
         free(w->found[t].ab);
     free(w->found);
     free(w->task);
+    free(w->task_first);
     memset(w, 0, sizeof *w);
 }
 

@@ -52,8 +52,10 @@ typedef struct cs_index_pairs {
 typedef struct cs_bvh_work {
     int ntasks, task_capacity;
     int *task;                 /* 2 per task: a node of A, a node of B */
-    cs_index_pairs *found;     /* per task */
-    int found_capacity;
+    int *task_first;           /* 3 per task: its first pair in its thread's */
+    int task_slots;            /* list, how many, which thread; for task_slots tasks */
+    cs_index_pairs *found;     /* per thread */
+    int nthreads;
 } cs_bvh_work;
 void cs_bvh_work_free(cs_bvh_work *w);
 
@@ -61,7 +63,7 @@ void cs_bvh_work_free(cs_bvh_work *w);
  * share no particle (for A == B each unordered pair once, as a < b), into
  * out in the order of a depth-first traversal whatever the thread count:
  * the node pairs near the top become tasks that OpenMP threads traverse
- * into their own lists, joined in task order. The boxes are those of the
+ * into one list per thread, joined in task order. The boxes are those of the
  * last cs_bvh_refit of each tree. With rank >= 0 (after cs_bvh_set_ranks
  * on both trees), node pairs that cannot hold a pair going to rank.
  * Returns 0 or -1 (no memory). */
