@@ -72,10 +72,21 @@ void cs_run_print_plan(const cs_scene *scene, const cs_sim *sim, FILE *out)
             scene->frames, scene->def.fps > 0 ? scene->frames / scene->def.fps : 0.0,
             cs_sim_particle_count(sim));
     /* a plan holds the scene, the mesh, the bodies' level sets and the
-     * springs; a run adds the step's scratch (plan_only leaves it out) */
+     * springs; a run adds the step's scratch (plan_only leaves it out),
+     * estimated per particle from the benchmark's measurements */
     struct rusage ru;
-    if (getrusage(RUSAGE_SELF, &ru) == 0)
-        fprintf(out, "memory for the setup: %.0f MiB at its peak (this process); a run adds "
-                "the step's arrays and the pair lists, which grow with the contacts\n",
-                ru.ru_maxrss / 1024.0);
+    if (getrusage(RUSAGE_SELF, &ru) != 0)
+        return;
+    double setup = ru.ru_maxrss * 1024.0, n = cs_sim_particle_count(sim);
+    bool self = scene->def.self_collision;
+    char at_setup[32], first[32], contact[32];
+    cs_format_bytes(setup, at_setup, sizeof at_setup);
+    cs_format_bytes(setup + cs_sim_estimate_bytes(n, self, false), first, sizeof first);
+    cs_format_bytes(setup + cs_sim_estimate_bytes(n, self, true), contact, sizeof contact);
+    fprintf(out, "memory: %s for the setup (this process, measured); a run needs about %s",
+            at_setup, first);
+    if (self)
+        fprintf(out, " over its first frames and about %s once the cloth lies on itself "
+                "(step A's pair lists grow with the contacts)", contact);
+    fprintf(out, "\n  (estimates per particle from the benchmark drape, docs/performance.md)\n");
 }

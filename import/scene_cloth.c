@@ -269,7 +269,7 @@ static int convert_grid(loader *L, const cs_raw_grid *g, const char *base, int r
      * 5000 x 5000 grid used to take 13.8 GB before anything said no). */
     double particles = (double)(res[0] + 1) * (res[1] + 1), all = L->particles + particles;
     char why[160];
-    if (!cs_memory_fits(cs_sim_estimate_bytes(all, L->self_collision), why, sizeof why)) {
+    if (!cs_memory_fits(cs_sim_estimate_bytes(all, L->self_collision, false), why, sizeof why)) {
         snprintf(p, sizeof p, "%s.grid.resolution", base);
         return cs_sl_fail(L, p, false, "%d x %d quads (%.3g particles%s) to simulate%s: %s", res[0],
                           res[1], particles, all > particles ? " with the cloths before" : "",

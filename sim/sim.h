@@ -356,10 +356,12 @@ const char *cs_stage_description(cs_stage stage);
 const char *cs_stage_condition(cs_stage stage);
 /* When the stage runs ("each time step", ...). */
 const char *cs_stage_when(cs_stage stage);
-/* The memory a run of this many particles will need at its peak, bytes (an
- * estimate from measurements, with a margin), so that a scene too large
- * for the machine is refused before anything is allocated. */
-double cs_sim_estimate_bytes(double particles, bool self_collision);
+/* The memory a run of this many particles will need at its peak beyond
+ * the setup, bytes (an estimate from measurements, with a margin): over its
+ * first frames, so that a scene too large for the machine is refused
+ * before anything is allocated, or, with in_contact, once the cloth lies
+ * on itself and step A's pair lists have grown (clothsim run --plan). */
+double cs_sim_estimate_bytes(double particles, bool self_collision, bool in_contact);
 
 typedef struct cs_plan {
     int nstages;

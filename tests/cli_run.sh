@@ -119,6 +119,7 @@ run 0 run tiny.yaml --plan -o planned
 [ ! -e planned ] || fail "--plan created its output directory"
 grep -q '1\. ' out.txt || fail "--plan printed no numbered stages"
 grep -q 'step' out.txt || fail "--plan printed no step size"
+grep -q 'memory: .* for the setup .*a run needs about ' out.txt || fail "--plan printed no memory estimate"
 python3 -c '
 import json, sys
 plan = json.load(open("out/tiny/summary.json"))["plan"]
