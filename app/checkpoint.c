@@ -431,38 +431,103 @@ static int compare_identity(hid_t f, const char *path, const cs_run_identity *id
     return rc;
 }
 
-int cs_checkpoint_read(const char *path, const cs_run_identity *id, cs_sim *sim, int *frame,
-                       double *totals, char *err, size_t errlen)
+/* Opens path as a state file of this format version into *f; what
+ * ("resume", "start from it") words the refusals. */
+static int state_open(const char *path, const char *what, hid_t *f, char *err, size_t errlen)
 {
     quiet_hdf5();
     FILE *probe = fopen(path, "rb");
     if (!probe) {
         if (errno == ENOENT)
-            snprintf(err, errlen, "cannot resume: there is no %s (a run writes it after each "
-                     "frame)", path);
+            snprintf(err, errlen, "cannot %s: there is no %s (a run writes it after each "
+                     "frame)", what, path);
         else
             snprintf(err, errlen, "cannot read %s: %s", path, strerror(errno));
         return errno == ENOENT ? CS_EXIT_INPUT : CS_EXIT_OUTPUT;
     }
     fclose(probe);
-    hid_t f = H5Fopen(path, H5F_ACC_RDONLY, H5P_DEFAULT);
+    *f = H5Fopen(path, H5F_ACC_RDONLY, H5P_DEFAULT);
     char kind[32] = "";
     int version = 0;
-    if (f < 0 || attr_read_string(f, "format", kind, sizeof kind) != 0 ||
+    if (*f < 0 || attr_read_string(*f, "format", kind, sizeof kind) != 0 ||
         strcmp(kind, STATE_FORMAT) != 0 ||
-        attr_read(f, "format_version", H5T_NATIVE_INT, &version) != 0) {
-        snprintf(err, errlen, "cannot resume: %s is not a clothsim state file", path);
-        if (f >= 0)
-            H5Fclose(f);
+        attr_read(*f, "format_version", H5T_NATIVE_INT, &version) != 0) {
+        snprintf(err, errlen, "cannot %s: %s is not a clothsim state file", what, path);
+        if (*f >= 0)
+            H5Fclose(*f);
         return CS_EXIT_INPUT;
     }
     if (version != STATE_FORMAT_VERSION) {
-        snprintf(err, errlen, "cannot resume: %s is a state file of format version %d; this "
-                 "clothsim reads version %d", path, version, STATE_FORMAT_VERSION);
-        H5Fclose(f);
+        snprintf(err, errlen, "cannot %s: %s is a state file of format version %d; this "
+                 "clothsim reads version %d", what, path, version, STATE_FORMAT_VERSION);
+        H5Fclose(*f);
         return CS_EXIT_INPUT;
     }
-    int rc = compare_identity(f, path, id, err, errlen);
+    return CS_EXIT_OK;
+}
+
+/* The dataset at path as a malloc'd array of *count doubles (NULL, 0 when
+ * it is missing or empty). */
+static double *doubles_read_all(hid_t f, const char *path, size_t *count)
+{
+    hid_t d = H5Lexists(f, path, H5P_DEFAULT) > 0 ? H5Dopen2(f, path, H5P_DEFAULT) : -1;
+    hid_t space = d >= 0 ? H5Dget_space(d) : -1;
+    hssize_t n = space >= 0 ? H5Sget_simple_extent_npoints(space) : -1;
+    double *data = n > 0 ? malloc(sizeof *data * (size_t)n) : NULL;
+    if (data && H5Dread(d, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, data) < 0) {
+        free(data);
+        data = NULL;
+    }
+    *count = data ? (size_t)n : 0;
+    if (space >= 0)
+        H5Sclose(space);
+    if (d >= 0)
+        H5Dclose(d);
+    return data;
+}
+
+int cs_checkpoint_read_start(const char *path, cs_start_state *st, char *err, size_t errlen)
+{
+    memset(st, 0, sizeof *st);
+    hid_t f;
+    int rc = state_open(path, "start from it", &f, err, errlen);
+    if (rc != CS_EXIT_OK)
+        return rc;
+    size_t nx = 0, nv = 0, nlag = 0;
+    if (attr_read(f, "frame", H5T_NATIVE_INT, &st->frame) != 0 ||
+        attr_read(f, "particles", H5T_NATIVE_INT, &st->particles) != 0 ||
+        attr_read(f, "time", H5T_NATIVE_DOUBLE, &st->time) != 0 || st->particles < 1 ||
+        !(st->x = doubles_read_all(f, "/state/positions", &nx)) ||
+        !(st->v = doubles_read_all(f, "/state/velocities", &nv)) ||
+        nx != 3 * (size_t)st->particles || nv != nx) {
+        snprintf(err, errlen, "cannot start from %s: it lacks the frame, the time or the "
+                 "positions and velocities of its particles", path);
+        rc = CS_EXIT_OUTPUT;
+    }
+    st->lag = rc == CS_EXIT_OK ? doubles_read_all(f, "/state/scripts/lag", &nlag) : NULL;
+    st->nlag = (int)nlag;
+    H5Fclose(f);
+    if (rc != CS_EXIT_OK)
+        cs_start_state_free(st);
+    return rc;
+}
+
+void cs_start_state_free(cs_start_state *st)
+{
+    free(st->x);
+    free(st->v);
+    free(st->lag);
+    memset(st, 0, sizeof *st);
+}
+
+int cs_checkpoint_read(const char *path, const cs_run_identity *id, cs_sim *sim, int *frame,
+                       double *totals, char *err, size_t errlen)
+{
+    hid_t f;
+    int rc = state_open(path, "resume", &f, err, errlen);
+    if (rc != CS_EXIT_OK)
+        return rc;
+    rc = compare_identity(f, path, id, err, errlen);
     char stored_hash[CS_STATE_HASH_LEN] = "";
     if (rc == 0 && (attr_read(f, "frame", H5T_NATIVE_INT, frame) != 0 ||
                     attr_read_string(f, "state_hash", stored_hash, sizeof stored_hash) != 0 ||

@@ -82,4 +82,20 @@ int cs_checkpoint_write(const char *path, const cs_run_identity *id, int frame,
 int cs_checkpoint_read(const char *path, const cs_run_identity *id, cs_sim *sim, int *frame,
                        double *totals, char *err, size_t errlen);
 
+/* Another run's state, the start of `clothsim run --start-from`: read
+ * without comparing identities (the caller maps it onto its own cloth). */
+typedef struct cs_start_state {
+    int frame;            /* the frame it was written after */
+    double time;
+    int particles;
+    double *x, *v;        /* 3 per particle (malloc'd) */
+    int nlag;             /* the scripts' lags (NULL, 0 without scripts) */
+    double *lag;
+} cs_start_state;
+
+/* Returns 0, CS_EXIT_INPUT (not a state file) or CS_EXIT_OUTPUT
+ * (unreadable), with err naming the file. */
+int cs_checkpoint_read_start(const char *path, cs_start_state *st, char *err, size_t errlen);
+void cs_start_state_free(cs_start_state *st);
+
 #endif

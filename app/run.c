@@ -179,6 +179,24 @@ int cs_run_main(int argc, char **argv)
     s->triangles = triangles;
     s->plan = *cs_sim_plan(r.sim);
 
+    /* before the folder is cleared: a refused start loses no frames */
+    if (o.start_from) {
+        struct stat from_st, out_st;
+        if (stat(o.start_from, &from_st) == 0 && stat(r.out.dir, &out_st) == 0 &&
+            from_st.st_dev == out_st.st_dev && from_st.st_ino == out_st.st_ino) {
+            snprintf(err, sizeof err, "--start-from %s: the run to start from is the output "
+                     "folder, whose frames a new run removes: give another -o DIR",
+                     o.start_from);
+            status = CS_EXIT_INPUT;
+        } else {
+            status = root ? cs_start_from_open(o.start_from, scene, &r.origin, err, sizeof err)
+                          : CS_EXIT_OK;
+        }
+        if (root && status != CS_EXIT_OK)
+            fprintf(stderr, "clothsim: %s\n", err);
+        if ((status = cs_sim_agree(r.sim, status)) != CS_EXIT_OK)
+            goto done;
+    }
     if (o.render && root) {
         r.render = cs_run_render_create(scene, r.sim, o.render, o.render_size, o.render_samples,
                                         r.out.dir, &status);
@@ -188,6 +206,7 @@ int cs_run_main(int argc, char **argv)
     status = cs_run_simulate(&r, &o);
 
 done:
+    cs_start_from_close(r.origin);
     cs_run_render_destroy(r.render);
     cs_summary_free(&r.summary);
     free(r.views);

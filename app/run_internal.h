@@ -9,6 +9,7 @@
 
 #include "app/checkpoint.h"
 #include "app/outdir.h"
+#include "app/start_from.h"
 #include "app/scene_render.h"
 #include "app/summary.h"
 #include "import/import.h"
@@ -29,6 +30,7 @@ typedef struct run_options {
     bool plan_only;
     bool quiet;
     bool resume;              /* --resume: continue the run in DIR */
+    const char *start_from;   /* --start-from RUN: begin where RUN ended */
     const char *render;       /* --render ENGINE, --size, --samples; NULL: none */
     const char *render_size, *render_samples;
     int threads;              /* --threads N; 0: one per core (see cs_parallel_set_threads) */
@@ -50,6 +52,7 @@ typedef struct run_state {
     double summary_at;       /* cs_now() of the last summary.json written */
     cs_mesh_view *views;     /* one per cloth */
     cs_run_render *render;   /* --render: an image per frame too */
+    cs_start_from *origin;   /* --start-from: the run it begins from; NULL: none */
     cs_summary summary;
     double start;            /* cs_now() when the command began */
 } run_state;

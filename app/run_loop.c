@@ -176,6 +176,69 @@ static int record_frame(run_state *r, int frame, const cs_frame_stats *stats, do
     return CS_EXIT_INTERRUPTED;
 }
 
+/* Rank 0, --start-from: frame 0 (this scene's start), then frames 1 to N
+ * of the run carried over (start_from.h), each with a record that says so,
+ * and frame N's state, which the run continues from: *first_frame = N.
+ * Returns an exit status, with the reason printed. */
+static int start_from_output(run_state *r, const char *run_dir, bool quiet, int *first_frame)
+{
+    char err[ERRLEN];
+    cs_summary *s = &r->summary;
+    int last = cs_start_from_frame(r->origin), status = CS_EXIT_OK;
+    if (write_frame(r, 0, err, sizeof err) != CS_OK)
+        status = CS_EXIT_OUTPUT;
+    for (int f = 1; f <= last && status == CS_EXIT_OK; f++) {
+        status = cs_start_from_load_frame(r->origin, f, r->sim, err, sizeof err);
+        if (status != CS_EXIT_OK)
+            break;
+        cs_frame_record rec = {.frame = f, .time = cs_sim_time(r->sim), .body_penetration = -1,
+                               .resampled_from = run_dir};
+        rec.stats.intersections = -1;
+        if (f == last) { /* the state simulated from: counted, as every frame is */
+            rec.stats.intersections = cs_sim_count_intersections(r->sim);
+            if (rec.stats.intersections != 0 && !r->scene->allow_intersecting_start) {
+                snprintf(err, sizeof err, "--start-from %s: frame %d carried onto this cloth "
+                         "has %ld intersecting triangle pairs (the finer triangles cut "
+                         "across the run's creases, or its cloth intersected); "
+                         "check.allow_intersecting_start: true starts from it anyway",
+                         run_dir, f, rec.stats.intersections);
+                status = CS_EXIT_INPUT;
+                break;
+            }
+            /* a held vertex off its script would jump there in one step */
+            int vertex;
+            double reach, off = cs_sim_script_offset(r->sim, &vertex);
+            cs_sim_script_step_cap(r->sim, &reach);
+            if (off > reach) {
+                snprintf(err, sizeof err, "--start-from %s: scripted particle %d of this scene "
+                         "is %.3g m from where its script puts it at t=%.6g s (more than its "
+                         "script reach of %.3g m a step): the scene scripts vertices "
+                         "the run did not (a selection that takes more vertices at this "
+                         "resolution?)", run_dir, vertex, off, cs_sim_time(r->sim), reach);
+                status = CS_EXIT_INPUT;
+                break;
+            }
+        }
+        cs_state_hash(r->sim, rec.state_hash);
+        if (write_frame(r, f, err, sizeof err) != CS_OK ||
+            cs_summary_add_frame(s, &rec, err, sizeof err) != 0 ||
+            (f == last && save_state(r, f, rec.state_hash, err, sizeof err) != 0))
+            status = CS_EXIT_OUTPUT;
+    }
+    if (status != CS_EXIT_OK) {
+        fprintf(stderr, "clothsim: %s\n", err);
+        s->status = "failed";
+        s->error = "the run to start from could not be carried over";
+        write_summary(r, err, sizeof err);
+        return status;
+    }
+    if (!quiet)
+        fprintf(stderr, "clothsim: starting after frame %d (t=%.6g s) of %s, carried onto %d "
+                "particles\n", last, cs_sim_time(r->sim), run_dir, cs_sim_particle_count(r->sim));
+    *first_frame = last;
+    return CS_EXIT_OK;
+}
+
 /* Rank 0, before the first frame simulated: frame 0 and its state, or
  * after --resume only the summary. Returns as record_frame does. */
 static int start_output(run_state *r, cs_progress *progress)
@@ -233,10 +296,13 @@ int cs_run_simulate(run_state *r, const run_options *o)
     if (root)
         status = cs_outdir_start(&r->out, o->resume, o->quiet, &r->id, r->sim, &r->summary,
                                  r->scene->frames, &r->first_frame);
+    if (root && status == CS_EXIT_OK && r->origin)
+        status = start_from_output(r, o->start_from, o->quiet, &r->first_frame);
     if ((status = cs_sim_agree(r->sim, status)) != CS_EXIT_OK)
         return status;
     r->first_frame = cs_sim_agree(r->sim, r->first_frame);
-    if (o->resume && cs_sim_state_scatter(r->sim) != CS_OK) { /* every rank takes it */
+    if ((o->resume || o->start_from) && cs_sim_state_scatter(r->sim) != CS_OK) {
+        /* every rank takes it */
         if (root)
             fprintf(stderr, "clothsim: out of memory\n");
         return CS_EXIT_OUTPUT;

@@ -40,7 +40,13 @@ void cs_run_help(FILE *out)
         "                       kill, a crash or --frames K): the same scene and --set\n"
         "                       overrides are required (--frames may grow), and the\n"
         "                       frames are the bits of a run never interrupted (same\n"
-        "                       rank count)\n"
+        "                       rank count)\n",
+        out);
+    fputs(
+        "      --start-from RUN begin where the run folder RUN ended: its last state\n"
+        "                       (and its frames, as frames 1 to N here) carried onto\n"
+        "                       this scene's cloths of the same rest shape, at any\n"
+        "                       resolution; then frames N+1 to --frames are simulated\n"
         "      --set KEY=VALUE  override a scene setting; KEY is a dotted path, VALUE is\n"
         "                       YAML, e.g. --set time.frames=10 --set gravity=[0,-9.8,0]\n"
         "                       --set cloths.0.material.node_mass=2e-6; repeatable, a\n"
@@ -86,12 +92,13 @@ void cs_run_help(FILE *out)
 static const cs_cli CLI = {
     "run",
     "usage: clothsim run SCENE [-o DIR] [--set KEY=VALUE]... [--format ply|obj|glb]\n"
-    "                    [--frames N] [--threads N] [--plan] [--resume] [--quiet]\n"
+    "                    [--frames N] [--threads N] [--plan] [--resume] [--start-from RUN]\n"
+    "                    [--quiet]\n"
     "'clothsim run --help' explains every option.\n",
     NULL, CS_EXIT_USAGE};
 
 enum { OPT_SET = 256, OPT_FORMAT, OPT_FRAMES, OPT_PLAN, OPT_RENDER, OPT_SIZE, OPT_SAMPLES,
-       OPT_THREADS, OPT_RESUME };
+       OPT_THREADS, OPT_RESUME, OPT_START_FROM };
 
 /* Whether text is a whole number in [lo, hi] (stored in *out if given). */
 static bool whole_number(const char *text, long lo, long hi, int *out)
@@ -119,6 +126,7 @@ int cs_run_parse_options(int argc, char **argv, run_options *o)
         {"samples", required_argument, NULL, OPT_SAMPLES},
         {"threads", required_argument, NULL, OPT_THREADS},
         {"resume", no_argument, NULL, OPT_RESUME},
+        {"start-from", required_argument, NULL, OPT_START_FROM},
         {"quiet", no_argument, NULL, 'q'},
         {"help", no_argument, NULL, 'h'},
         {NULL, 0, NULL, 0},
@@ -170,6 +178,11 @@ int cs_run_parse_options(int argc, char **argv, run_options *o)
         case OPT_RESUME:
             o->resume = true;
             break;
+        case OPT_START_FROM:
+            if (!*optarg)
+                return cs_cli_error(&CLI, "%s", "--start-from needs a run folder");
+            o->start_from = optarg;
+            break;
         case OPT_RENDER:
             o->render = optarg;
             break;
@@ -205,6 +218,9 @@ int cs_run_parse_options(int argc, char **argv, run_options *o)
             o->out_dir = o->scene_path;
         o->scene_path = o->scene_in_dir;
     }
+    if (o->start_from && o->resume)
+        return cs_cli_error(&CLI, "%s", "--start-from begins a new run; --resume continues one: "
+                                        "give one of them");
     if ((o->render_size || o->render_samples) && !o->render)
         return cs_cli_error(&CLI, "%s", "--size and --samples go with --render ENGINE");
     if (frames) {

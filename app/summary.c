@@ -205,6 +205,8 @@ static cJSON *build_json(const cs_summary *s, builder *b)
         add_str(b, root, "initial_state_hash", s->initial_hash);
     if (s->resumed_from >= 0)
         add_num(b, root, "resumed_from_frame", s->resumed_from);
+    if (s->carried_frames > 0) /* frames 1.. carried from another run (their records say which) */
+        add_num(b, root, "carried_frames", s->carried_frames);
     return root;
 }
 
@@ -245,6 +247,8 @@ static cJSON *frame_json(const cs_summary *s, const cs_frame_record *f, builder 
         add_num(b, o, "body_penetration_max", f->body_penetration);
     add_num(b, o, "seconds", f->seconds);
     add_str(b, o, "state_hash", f->state_hash);
+    if (f->resampled_from)
+        add_str(b, o, "resampled_from", f->resampled_from);
     return o;
 }
 
@@ -266,6 +270,7 @@ static int each_line(char *text, int (*fn)(char *line, void *ctx), void *ctx)
 
 typedef struct trim_ctx {
     int keep, next;       /* keep frames 1..keep; the frame expected next */
+    int carried;          /* of those, records of frames carried over */
     size_t kept;          /* bytes of text kept */
     const char *text;
 } trim_ctx;
@@ -276,10 +281,12 @@ static int trim_line(char *line, void *ctx)
     cJSON *o = cJSON_Parse(line);
     const cJSON *f = o ? cJSON_GetObjectItemCaseSensitive(o, "frame") : NULL;
     int frame = cJSON_IsNumber(f) ? f->valueint : -1;
+    bool carried = o && cJSON_GetObjectItemCaseSensitive(o, "resampled_from");
     cJSON_Delete(o);
     if (frame != t->next)
         return -1; /* damaged, or a frame missing: t->next names it */
     t->next++;
+    t->carried += carried;
     t->kept = (size_t)(line - t->text) + strlen(line) + 1;
     return t->next > t->keep ? 1 : 0;
 }
@@ -297,7 +304,7 @@ int cs_summary_open_records(cs_summary *s, const char *path, int keep, char *err
             snprintf(err, errlen, "cannot read %s: %s", path, strerror(errno));
             return -1;
         }
-        trim_ctx t = {keep, 1, 0, text};
+        trim_ctx t = {keep, 1, 0, 0, text};
         each_line(text, trim_line, &t);
         if (t.next <= keep) {
             snprintf(err, errlen, "%s: the record of frame %d is missing or damaged; the run "
@@ -310,6 +317,7 @@ int cs_summary_open_records(cs_summary *s, const char *path, int keep, char *err
         if (rc != 0)
             return -1;
         s->nframes = keep;
+        s->carried_frames = t.carried;
         s->records_size = (long)t.kept;
     }
     s->records = fopen(path, keep > 0 ? "ab" : "wb");
@@ -350,7 +358,10 @@ int cs_summary_add_frame(cs_summary *s, const cs_frame_record *frame, char *err,
     }
     s->records_size += (long)len + 1;
     s->nframes++;
-    s->run_frames++;
+    if (frame->resampled_from) /* carried over, not simulated */
+        s->carried_frames++;
+    else
+        s->run_frames++;
     s->run_steps += frame->stats.steps;
     return 0;
 }
@@ -443,7 +454,7 @@ void cs_summary_print_table(const cs_summary *s, FILE *out)
     if (s->threads > 1)
         fprintf(out, "%d threads per rank\n", s->threads);
 
-    int simulated = s->nframes;
+    int simulated = s->nframes - s->carried_frames;
     fprintf(out, "\nwall time %.3f s (simulation %.3f s, output %.3f s)\n",
             s->total_seconds, s->simulation_seconds, s->output_seconds);
     if (simulated > 0) {

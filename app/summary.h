@@ -40,6 +40,8 @@ typedef struct cs_frame_record {
                                 at the frame's end, m (cs_sim_body_penetration);
                                 < 0: no bodies */
     char state_hash[CS_STATE_HASH_LEN]; /* positions and velocities at the end */
+    const char *resampled_from; /* not simulated: another run's frame carried onto
+                                   this cloth (run --start-from), that run's folder */
 } cs_frame_record;
 
 /* Totals a resumed run carries on from (cs_summary_totals): per stage
@@ -86,6 +88,8 @@ typedef struct cs_summary {
     char initial_hash[CS_STATE_HASH_LEN]; /* frame 0's state */
     int resumed_from;                /* the frame this command resumed from, else -1 */
     int nframes;                     /* records in frames.jsonl (frames 1..nframes) */
+    int carried_frames;              /* of which carried from another run, not
+                                        simulated (run --start-from) */
     int run_frames;                  /* of which simulated by this command, */
     long run_steps;                  /* in this many steps */
     /* frames.jsonl: open for appending, and its length after the last

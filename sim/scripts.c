@@ -65,3 +65,28 @@ void cs_scripts_hold_releasable(cs_sim *sim, bool hold)
             for (int j = 0; j < sim->scripts[s].nvertices; j++)
                 sim->is_free[sim->scripts[s].vertices[j]] = !hold;
 }
+
+double cs_sim_script_offset(const cs_sim *sim, int *vertex)
+{
+    double worst = 0;
+    *vertex = -1;
+    for (int s = 0; s < sim->nscripts; s++) {
+        const cs_script_state *sc = sim->scripts + s;
+        if (sc->released || (sc->release_time > 0 && sim->t >= sc->release_time))
+            continue;
+        double R[9], c[3];
+        cs_motion_pose(&sc->motion, sim->t - sim->script_lag[s], R, c, NULL, NULL);
+        for (int j = 0; j < sc->nvertices; j++) {
+            int g = sc->vertices[j];
+            double r[3], d2 = 0;
+            cs_mat_apply(R, sc->local + 3 * j, r);
+            for (int d = 0; d < 3; d++)
+                d2 += (c[d] + r[d] - sim->x[3 * g + d]) * (c[d] + r[d] - sim->x[3 * g + d]);
+            if (sqrt(d2) > worst) {
+                worst = sqrt(d2);
+                *vertex = g;
+            }
+        }
+    }
+    return worst;
+}

@@ -55,6 +55,22 @@ void cs_trimesh_destroy(cs_trimesh *mesh);
 cs_trimesh *cs_trimesh_create_grid(const double size[2], const int res[2],
                                    const double rotate[4], const double center[3]);
 
+
+/* Values on one mesh's vertices carried to another's through their shapes
+ * (sim/resample.c): each vertex of `to` takes the nearest point of `from`'s
+ * surface, a triangle and barycentric weights, and values (3 a vertex,
+ * positions or velocities) are interpolated there. Made from two rest
+ * shapes, it starts a cloth from a state of the same cloth at another
+ * resolution (clothsim run --start-from). Returns NULL when out of memory
+ * or `from` has no triangle; *worst: the largest distance of a `to` vertex
+ * from `from`'s surface, in metres. */
+typedef struct cs_surface_map cs_surface_map;
+cs_surface_map *cs_surface_map_create(const cs_trimesh *from, const cs_trimesh *to,
+                                      double *worst);
+/* to_values: 3 per vertex of the `to` mesh the map was made for */
+void cs_surface_map_apply(const cs_surface_map *map, const cs_trimesh *from,
+                          const double *from_values, double *to_values);
+void cs_surface_map_destroy(cs_surface_map *map);
 /* ---------------------------------------------------------------- motion */
 
 /* One key of a keyframed rigid motion: at `time` the object's frame sits at
@@ -499,6 +515,10 @@ const char *cs_sim_step_limit_why(const cs_sim *sim);
  * thickness; never below the undamped step), and that reach in metres;
  * INFINITY when no script moves then */
 double cs_sim_script_step_cap(const cs_sim *sim, double *reach);
+/* How far the scripted particle farthest from its script's pose now (on
+ * the script's own clock) is from it, m, and which particle (-1: none held):
+ * a state given from outside (run --start-from) must put them there. */
+double cs_sim_script_offset(const cs_sim *sim, int *vertex);
 double cs_sim_undamped_dt(const cs_sim *sim);
 double cs_sim_gershgorin_dt(const cs_sim *sim);
 int cs_sim_particle_count(const cs_sim *sim);
