@@ -10,11 +10,12 @@ Three measurements, each a plain `clothsim run` at the scene's defaults
   twist 0.5M  scenes/figures/twist.yaml at 1000 x 250 quads (501,000
               triangles, thickness 0.4 mm) resumed from a tangled state for
               2 frames: the state is a run folder made once by
-                clothsim run scenes/figures/twist.yaml -o out/twist_500k \\
-                  --set 'cloths.0.grid.resolution=[1000,250]' \\
-                  --set self_collision.thickness=0.0004 --frames 40
-              (hours on 2 cores; not committed, a few GB) and given with
-              --twist-state out/twist_500k. Without it the twist is skipped.
+                bench/twist_state.sh build out/twist_500k
+              (frame 42, made at coarser resolutions and carried onto the
+              fine cloth with run --start-from, which then simulates frame
+              42 itself: about 10 minutes on 2 cores; not committed, about
+              1 GB) and given with --twist-state out/twist_500k. Without it
+              the twist is skipped.
   twist0      the same twist's first frame from rest (--only twist0, not run
               by default: about 11 minutes a run on 2 cores)
 
