@@ -6,7 +6,6 @@
 #include "app/outdir.h"
 #include "common/util.h"
 
-#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -28,19 +27,6 @@ struct cs_start_from {
     cs_trimesh **file_rest;      /* per cloth: frame 0 as the file holds it */
 };
 
-static double mean_edge(const cs_trimesh *m)
-{
-    double sum = 0;
-    for (int t = 0; t < m->nt; t++)
-        for (int k = 0; k < 3; k++) {
-            const double *a = m->x + 3 * m->tri[3 * t + k];
-            const double *b = m->x + 3 * m->tri[3 * t + (k + 1) % 3];
-            sum += sqrt((a[0] - b[0]) * (a[0] - b[0]) + (a[1] - b[1]) * (a[1] - b[1]) +
-                        (a[2] - b[2]) * (a[2] - b[2]));
-        }
-    return m->nt > 0 ? sum / (3.0 * m->nt) : 0;
-}
-
 /* The map of cloth c from mesh (the run's rest shape) onto the new rest
  * shape; refused when the shapes differ. */
 static int map_cloth(const cs_start_from *s, int c, const cs_trimesh *mesh, cs_surface_map **out,
@@ -53,7 +39,7 @@ static int map_cloth(const cs_start_from *s, int c, const cs_trimesh *mesh, cs_s
         snprintf(err, errlen, "out of memory");
         return CS_EXIT_OUTPUT;
     }
-    double allowed = REST_TOLERANCE * mean_edge(mesh);
+    double allowed = REST_TOLERANCE * cs_trimesh_mean_edge(mesh);
     if (!(worst <= allowed)) {
         snprintf(err, errlen, "cannot start from %s: cloth '%s' at rest is not the run's cloth "
                  "at rest: a vertex lies %.3g m from it (at most %.3g m allowed); "

@@ -1,4 +1,5 @@
 /* mesh.c: triangle meshes and the generated rectangle grid. */
+#include <math.h>
 #include <stdlib.h>
 
 #include "sim/internal.h"
@@ -30,6 +31,18 @@ void cs_trimesh_destroy(cs_trimesh *m)
     free(m->x);
     free(m->tri);
     free(m);
+}
+
+double cs_trimesh_mean_edge(const cs_trimesh *m)
+{
+    double sum = 0;
+    for (int t = 0; t < m->nt; t++)
+        for (int k = 0; k < 3; k++) {
+            double d[3];
+            cs_sub(m->x + 3 * m->tri[3 * t + k], m->x + 3 * m->tri[3 * t + (k + 1) % 3], d);
+            sum += cs_norm(d);
+        }
+    return m->nt > 0 ? sum / (3.0 * m->nt) : 0;
 }
 
 cs_trimesh *cs_trimesh_create_grid(const double size[2], const int res[2],

@@ -62,7 +62,7 @@ static void tri_box(const cs_trimesh *m, int t, double lo[3], double hi[3])
 /* Two passes over the triangles: count each cell's, then fill. */
 static int grid_build(tri_grid *g, const cs_trimesh *m)
 {
-    double hi[3], edge = 0;
+    double hi[3];
     for (int d = 0; d < 3; d++) {
         g->lo[d] = INFINITY;
         hi[d] = -INFINITY;
@@ -72,13 +72,8 @@ static int grid_build(tri_grid *g, const cs_trimesh *m)
             g->lo[d] = fmin(g->lo[d], m->x[3 * i + d]);
             hi[d] = fmax(hi[d], m->x[3 * i + d]);
         }
-    for (int t = 0; t < m->nt; t++) {
-        const double *a = m->x + 3 * m->tri[3 * t], *b = m->x + 3 * m->tri[3 * t + 1];
-        edge += sqrt((a[0] - b[0]) * (a[0] - b[0]) + (a[1] - b[1]) * (a[1] - b[1]) +
-                     (a[2] - b[2]) * (a[2] - b[2]));
-    }
     double extent = fmax(hi[0] - g->lo[0], fmax(hi[1] - g->lo[1], hi[2] - g->lo[2]));
-    g->cell = m->nt > 0 ? 2 * edge / m->nt : 0;
+    g->cell = 2 * cs_trimesh_mean_edge(m);
     if (!(g->cell > 0))
         g->cell = extent > 0 ? extent : 1;
     for (;;) {

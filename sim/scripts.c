@@ -78,12 +78,12 @@ double cs_sim_script_offset(const cs_sim *sim, int *vertex)
         cs_motion_pose(&sc->motion, sim->t - sim->script_lag[s], R, c, NULL, NULL);
         for (int j = 0; j < sc->nvertices; j++) {
             int g = sc->vertices[j];
-            double r[3], d2 = 0;
+            double r[3], off[3];
             cs_mat_apply(R, sc->local + 3 * j, r);
             for (int d = 0; d < 3; d++)
-                d2 += (c[d] + r[d] - sim->x[3 * g + d]) * (c[d] + r[d] - sim->x[3 * g + d]);
-            if (sqrt(d2) > worst) {
-                worst = sqrt(d2);
+                off[d] = c[d] + r[d] - sim->x[3 * g + d];
+            if (cs_norm(off) > worst) {
+                worst = cs_norm(off);
                 *vertex = g;
             }
         }

@@ -46,6 +46,9 @@ typedef struct cs_trimesh {
 
 cs_trimesh *cs_trimesh_create(int nv, int nt);
 void cs_trimesh_destroy(cs_trimesh *mesh);
+/* The mean length of the triangles' edges (an edge of two triangles counted
+ * twice); 0 without triangles. */
+double cs_trimesh_mean_edge(const cs_trimesh *mesh);
 
 /* A rectangle of size[0] x size[1] metres split into res[0] x res[1] quads
  * (two triangles each, diagonals alternating so the grid has no preferred
