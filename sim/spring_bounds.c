@@ -10,9 +10,13 @@
 #include "sim/springs.h"
 #include "sim/vec3.h"
 
-/* Gershgorin over the free particles' rows: max_i (2 / m_i) sum of each
- * spring's term, the term k = E / L0 (damped false) or the damped scheme's
- * at dt and rest (cs_spring_step_term). -1 when memory runs out. */
+/* Gershgorin's theorem on the free particles' rows: a spring's term (the
+ * norm of its 3 x 3 block) counts on row i's diagonal and, when its far end
+ * is free too, once more off it; a pinned or scripted end is no unknown, so
+ * it has no off-diagonal entry (beside a scripted edge, where a twist's
+ * tension peaks, that halves the share of the springs that reach it).
+ * The term is k = E / L0 (damped false) or the damped scheme's at dt and
+ * rest (cs_spring_step_term). -1 when memory runs out. */
 static double rest_row_bound(const cs_springs *s, const double *mass,
                              const unsigned char *is_free, int nparticles, bool damped,
                              double dt)
@@ -23,13 +27,14 @@ static double rest_row_bound(const cs_springs *s, const double *mass,
     for (int k = 0; k < s->n; k++) {
         double kk = s->stiffness[k] * s->inv_rest_length[k];
         double term = damped ? cs_spring_step_term(dt, kk, s->damping[k], 0) : kk;
-        sum[s->ends[2 * k]] += term;
-        sum[s->ends[2 * k + 1]] += term;
+        int i = s->ends[2 * k], j = s->ends[2 * k + 1];
+        sum[i] += term * (1 + is_free[j]);
+        sum[j] += term * (1 + is_free[i]);
     }
     double bound = 0;
     for (int i = 0; i < nparticles; i++)
-        if (is_free[i] && 2.0 * sum[i] / mass[i] > bound)
-            bound = 2.0 * sum[i] / mass[i];
+        if (is_free[i] && sum[i] / mass[i] > bound)
+            bound = sum[i] / mass[i];
     free(sum);
     return bound;
 }
@@ -64,8 +69,9 @@ double cs_springs_step_bound(const cs_springs *s, const double *mass,
             for (int e = s->row_start[r]; e < s->row_start[r + 1]; e++)
                 sum += cs_spring_step_term(dt, s->row_stiffness[e] * s->row_inv_rest_length[e],
                                            s->row_sqrt_damping[e] * s->row_sqrt_damping[e],
-                                           s->row_magnitude[e]);
-            row_bound = 2.0 * sum / mass[i];
+                                           s->row_magnitude[e]) *
+                       (1 + is_free[s->row_other[e]]); /* as rest_row_bound */
+            row_bound = sum / mass[i];
         }
         if (value)
             value[k] = row_bound;

@@ -163,7 +163,9 @@ static inline double cs_spring_step_term(double dt, double k, double c, double g
 }
 /* Gershgorin's bound on the largest eigenvalue of M^-1 (dt^2 K - 2 dt D)
  * at the rest state, over all springs and the free particles:
- * max_i (2 / m_i) sum over i's springs of cs_spring_step_term. */
+ * max_i (1 / m_i) sum over i's springs of cs_spring_step_term, each
+ * counted twice where its far end is free (diagonal and off-diagonal
+ * entry), once where it is pinned or scripted. */
 double cs_springs_rest_step_bound(const cs_springs *s, const double *mass,
                                   const unsigned char *is_free, int nparticles, double dt);
 /* The same over the rows (cs_springs_index) at the positions last given to

@@ -22,13 +22,18 @@
  * The test used: drop the springs whose damping outweighs their stiffness
  * at this dt (removing a negative semi-definite term only raises the
  * largest eigenvalue) and bound the rest by Gershgorin's theorem,
- *     max_i (2 / m_i) sum_s max(dt^2 k_s - 2 dt c_s, dt^2 g_s, 0) <= 4,
- * a sufficient condition, evaluated at the current positions before every
- * outer step. The largest dt passing it is found by bisection; each
- * evaluation is a maximum over particles (and ranks), so the step is the
- * same at every thread and rank count. The undamped limit from Lanczos
- * iterations (2 / omega_max at the rest state, the default step) stays a
- * floor: the step never becomes smaller than the default's.
+ *     max_i (1 / m_i) sum_s w_s max(dt^2 k_s - 2 dt c_s, dt^2 |g_s|, 0) <= 4,
+ * with w_s = 2 (the diagonal and the far particle's entry), or 1 where the
+ * far end is pinned or scripted and so no unknown (counting it twice put
+ * the twist's limit at the free particle beside its scripted corner, 24%
+ * above the next row): a sufficient condition, evaluated at the current
+ * positions before every outer step. The largest dt passing it is found
+ * by bisection; each evaluation is a maximum over particles (and ranks),
+ * so the step is the same at every thread and rank count. The undamped
+ * limit from Lanczos iterations (2 / omega_max at the rest state, the
+ * default step) stays a floor: the step never becomes smaller than the
+ * default's. tests/test_step_limit.c checks the bound against the
+ * spectrum itself.
  *
  * The default (time.step_limit: auto) takes the damped limit when the
  * cloth's damping makes it at least def.auto_min_gain times the undamped one
