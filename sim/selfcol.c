@@ -65,6 +65,8 @@ cs_selfcol *cs_selfcol_create(const cs_sim *sim)
     sc->pbox = calloc((size_t)n + 1, sizeof *sc->pbox);
     sc->ebox = calloc((size_t)ne + 1, sizeof *sc->ebox);
     sc->tbox = calloc((size_t)nt + 1, sizeof *sc->tbox);
+    sc->emotion = malloc(sizeof *sc->emotion * ((size_t)ne + 1));
+    sc->tmotion = malloc(sizeof *sc->tmotion * ((size_t)nt + 1));
     sc->pdirty = calloc((size_t)n + 1, 1);
     sc->vdirty = calloc((size_t)n + 1, 1);
     sc->collided = calloc((size_t)n + 1, 1);
@@ -82,7 +84,7 @@ cs_selfcol *cs_selfcol_create(const cs_sim *sim)
     sc->x_pass = malloc(sizeof(double) * 3 * (size_t)(n + 1));
     if (!sc->prim_rank || !sc->component || !sc->x_pass)
         goto fail;
-    if (!sc->pbox || !sc->ebox || !sc->tbox || !sc->pdirty || !sc->vdirty || !sc->collided ||
+    if (!sc->pbox || !sc->ebox || !sc->tbox || !sc->emotion || !sc->tmotion || !sc->pdirty || !sc->vdirty || !sc->collided ||
         !sc->edirty || !sc->tdirty || !sc->x_free || !sc->x_before || !sc->inv_mass || !sc->zone ||
         !sc->zone_list)
         goto fail;
@@ -133,7 +135,8 @@ void cs_selfcol_destroy(cs_selfcol *sc)
     cs_bvh_free(&sc->ptree);
     cs_bvh_free(&sc->etree);
     cs_bvh_free(&sc->ttree);
-    void *arrays[] = {sc->edge, sc->tri, sc->ring_start, sc->ring, sc->pbox, sc->ebox, sc->tbox, sc->pdirty, sc->collided, sc->edirty,
+    void *arrays[] = {sc->edge, sc->tri, sc->ring_start, sc->ring, sc->pbox, sc->ebox, sc->tbox,
+                      sc->emotion, sc->tmotion, sc->pdirty, sc->collided, sc->edirty,
                       sc->tdirty, sc->vdirty, sc->x_free, sc->x_before, sc->inv_mass, sc->zone,
                       sc->zone_list, sc->pt.p, sc->ee.p, sc->cpt.p, sc->cee.p,
                       sc->prim_rank, sc->component, sc->bpt.p, sc->bee.p, sc->x_pass,

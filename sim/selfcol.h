@@ -62,6 +62,13 @@ typedef struct cs_made_list {
     char pad[64 - 2 * sizeof(int) - sizeof(cs_made_pair *) - sizeof(double)];
 } cs_made_list;
 
+/* A primitive's extent in position (its vertices in x_free) and in velocity
+ * (theirs in v) at step A's search: what bounds, for every pair of two such
+ * primitives, the distance from below and the relative speed from above. */
+typedef struct cs_motion_box {
+    double lo[3], hi[3], vlo[3], vhi[3];
+} cs_motion_box;
+
 /* Candidate pairs kept between searches (selfcol_cache.c). */
 typedef struct cs_pair_cache {
     bool valid;
@@ -114,6 +121,7 @@ typedef struct cs_selfcol {
     int *ring_start, *ring;    /* each particle's neighbours along edges */
     cs_bvh ptree, etree, ttree;
     cs_box *pbox, *ebox, *tbox;
+    cs_motion_box *emotion, *tmotion; /* per edge and triangle, step A's */
     unsigned char *pdirty, *edirty, *tdirty, *vdirty;
     unsigned char *collided;   /* step C: in a pair the last pass found */
     double *x_free;            /* the last collision-free positions */

@@ -252,8 +252,9 @@ static long find_collisions(cs_selfcol *sc, const cs_par *par, const double *x,
     sc->cpt.n = sc->cee.n = 0;
     collector cl = {sc, par, x};
     if (sc_cache_update(sc, par->rank, thickness, NULL, NULL) ||
-        sc_find_pairs(sc, false, only_dirty, NULL, make_collision_point_triangle, &cl, &sc->cpt) ||
-        sc_find_pairs(sc, true, only_dirty, NULL, make_collision_edge_edge, &cl, &sc->cee))
+        sc_find_pairs(sc, false, only_dirty, NULL, NULL, make_collision_point_triangle, &cl,
+                      &sc->cpt) ||
+        sc_find_pairs(sc, true, only_dirty, NULL, NULL, make_collision_edge_edge, &cl, &sc->cee))
         return -1;
     return sc->cpt.n + sc->cee.n;
 }

@@ -57,12 +57,22 @@ void sc_cache_free(cs_selfcol *sc);
 typedef struct sc_skin {
     double thickness, span, gap_cap;
 } sc_skin;
+/* Step A's reach: its makers keep a pair only if it is closer than
+ * thickness + (relative speed) span, with the speed the largest between
+ * a vertex of each side, at x_free and the velocities v; the edges' and
+ * triangles' motion boxes (sc->emotion, tmotion) hold their extents in
+ * both. */
+typedef struct sc_reach {
+    double thickness, span;
+    const double *v;
+} sc_reach;
 /* The cached point/triangle (edges: edge/edge) pairs whose present boxes
- * overlap (only_dirty: with a dirty side), that skin (NULL: none) does not
- * show to be far, and that make accepts, appended to list in (a, b) order
- * at any thread count. Returns 0 or -1. */
-int sc_find_pairs(cs_selfcol *sc, bool edges, bool only_dirty, const sc_skin *skin,
-                  pair_maker make, const void *ctx, cs_pair_list *list);
+ * overlap (only_dirty: with a dirty side), that reach (NULL: none) does
+ * not show to be out of reach, that skin (NULL: none) does not show to be
+ * far, and that make accepts, appended to list in (a, b) order at any
+ * thread count. Returns 0 or -1. */
+int sc_find_pairs(cs_selfcol *sc, bool edges, bool only_dirty, const sc_reach *reach,
+                  const sc_skin *skin, pair_maker make, const void *ctx, cs_pair_list *list);
 
 /* ---- selfcol_project.c: zones across prescribed motions */
 /* Keeps a collision found in a zone pass (weights c, normal n oriented from

@@ -142,6 +142,23 @@ static bool make_repulsion_edge_edge(const void *ctx, int ea, int eb, cs_pair *o
     return true;
 }
 
+/* m = the extents of the vertices' positions in x and velocities in v */
+static void motion_box(cs_motion_box *m, const int *vert, int count, const double *x,
+                       const double *v)
+{
+    for (int d = 0; d < 3; d++) {
+        m->lo[d] = m->hi[d] = x[3 * vert[0] + d];
+        m->vlo[d] = m->vhi[d] = v[3 * vert[0] + d];
+        for (int j = 1; j < count; j++) {
+            double p = x[3 * vert[j] + d], u = v[3 * vert[j] + d];
+            m->lo[d] = p < m->lo[d] ? p : m->lo[d];
+            m->hi[d] = p > m->hi[d] ? p : m->hi[d];
+            m->vlo[d] = u < m->vlo[d] ? u : m->vlo[d];
+            m->vhi[d] = u > m->vhi[d] ? u : m->vhi[d];
+        }
+    }
+}
+
 void cs_selfcol_find_pairs(cs_sim *sim, double span)
 {
     cs_selfcol *sc = sim->selfcol;
@@ -211,6 +228,15 @@ void cs_selfcol_find_pairs(cs_sim *sim, double span)
             cs_box_add_point(b, sc->pbox[i].hi);
         }
     }
+    /* the motion boxes, for sc_find_pairs' reach */
+#pragma omp parallel for schedule(static)
+    for (int k = 0; k < sc->ne + sc->nt; k++) {
+        bool edge = k < sc->ne;
+        const int *vert = edge ? sc->edge + 2 * k : sc->tri + 3 * (k - sc->ne);
+        cs_motion_box *m = edge ? sc->emotion + k : sc->tmotion + (k - sc->ne);
+        motion_box(m, vert, edge ? 2 : 3, x, sim->v);
+    }
+    sc_reach reach = {thickness, span, sim->v};
     finder f = {sim, sc, thickness, span};
     for (int t = 0; t < sc->nmade; t++) /* threads added by the searches start at 0 */
         sc->made[t].nearest = INFINITY;
@@ -222,8 +248,9 @@ void cs_selfcol_find_pairs(cs_sim *sim, double span)
     double gap = 0.999 * thickness;
     sc_skin skin = {thickness, span, gap}, *use = sc->cache.skin_off ? NULL : &skin;
     int failed = sc_cache_update(sc, sim->par->rank, thickness, sim->v, mean) ||
-                 sc_find_pairs(sc, false, false, use, make_repulsion_point_triangle, &f, &sc->pt) ||
-                 sc_find_pairs(sc, true, false, use, make_repulsion_edge_edge, &f, &sc->ee);
+                 sc_find_pairs(sc, false, false, &reach, use, make_repulsion_point_triangle, &f,
+                               &sc->pt) ||
+                 sc_find_pairs(sc, true, false, &reach, use, make_repulsion_edge_edge, &f, &sc->ee);
     for (int t = 0; t < sc->nmade; t++)
         if (!(sc->made[t].nearest >= gap))
             gap = sc->made[t].nearest;
