@@ -91,6 +91,8 @@ typedef struct cs_pair_cache {
     double *moved, *speed;
     bool skin_off;               /* tests: step A measures every pair */
     long skin_skips;             /* pairs the skin spared the makers, in all */
+    bool reach_off;              /* tests: no reach test (sc_find_pairs) */
+    long reach_skips;            /* candidates the reach test skipped, in all */
 } cs_pair_cache;
 
 /* A collision inside an impact zone that spans two prescribed motions, as

@@ -379,8 +379,8 @@ int sc_find_pairs(cs_selfcol *sc, bool edges, bool only_dirty, const sc_reach *r
         sc->nmade = threads;
     }
     int failed = 0;
-    long skipped = 0;
-#pragma omp parallel reduction(| : failed) reduction(+ : skipped)
+    long skipped = 0, unreached = 0;
+#pragma omp parallel reduction(| : failed) reduction(+ : skipped, unreached)
     {
         cs_made_list *mine = sc->made + omp_get_thread_num();
         mine->n = 0;
@@ -392,8 +392,10 @@ int sc_find_pairs(cs_selfcol *sc, bool edges, bool only_dirty, const sc_reach *r
                 continue;
             if (reach && out_of_reach(edges ? sc->emotion + a : NULL, sc->x_free + 3 * a,
                                       reach->v + 3 * a,
-                                      edges ? sc->emotion + b : sc->tmotion + b, reach))
+                                      edges ? sc->emotion + b : sc->tmotion + b, reach)) {
+                unreached++;
                 continue;
+            }
             if (skin && skin_far(sc, edges, k, a, b, skin)) {
                 skipped++;
                 continue;
@@ -404,6 +406,7 @@ int sc_find_pairs(cs_selfcol *sc, bool edges, bool only_dirty, const sc_reach *r
         }
     }
     sc->cache.skin_skips += skipped;
+    sc->cache.reach_skips += unreached;
     if (failed)
         return -1;
     /* the threads' pairs joined, then in (a, b) order */

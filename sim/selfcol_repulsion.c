@@ -236,7 +236,7 @@ void cs_selfcol_find_pairs(cs_sim *sim, double span)
         cs_motion_box *m = edge ? sc->emotion + k : sc->tmotion + (k - sc->ne);
         motion_box(m, vert, edge ? 2 : 3, x, sim->v);
     }
-    sc_reach reach = {thickness, span, sim->v};
+    sc_reach reach = {thickness, span, sim->v}, *reaching = sc->cache.reach_off ? NULL : &reach;
     finder f = {sim, sc, thickness, span};
     for (int t = 0; t < sc->nmade; t++) /* threads added by the searches start at 0 */
         sc->made[t].nearest = INFINITY;
@@ -248,9 +248,9 @@ void cs_selfcol_find_pairs(cs_sim *sim, double span)
     double gap = 0.999 * thickness;
     sc_skin skin = {thickness, span, gap}, *use = sc->cache.skin_off ? NULL : &skin;
     int failed = sc_cache_update(sc, sim->par->rank, thickness, sim->v, mean) ||
-                 sc_find_pairs(sc, false, false, &reach, use, make_repulsion_point_triangle, &f,
+                 sc_find_pairs(sc, false, false, reaching, use, make_repulsion_point_triangle, &f,
                                &sc->pt) ||
-                 sc_find_pairs(sc, true, false, &reach, use, make_repulsion_edge_edge, &f, &sc->ee);
+                 sc_find_pairs(sc, true, false, reaching, use, make_repulsion_edge_edge, &f, &sc->ee);
     for (int t = 0; t < sc->nmade; t++)
         if (!(sc->made[t].nearest >= gap))
             gap = sc->made[t].nearest;

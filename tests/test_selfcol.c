@@ -367,10 +367,11 @@ static bool same_state(const cs_sim *a, const cs_sim *b)
 /* The broad phase only filters: the pairs of steps A and C, and so every
  * frame, are the same bits whether each search traverses the trees, reuses
  * the candidates kept since an earlier search (the default), or keeps them
- * with a far wider slack, and whether step A's distance skin spares the
- * makers the pairs it shows to be far or every pair is measured (the
- * first sim, the reference). A pair the kept candidates missed, or one the
- * skin dropped wrongly, would show as a different frame. */
+ * with a far wider slack, and whether step A's distance skin and reach
+ * test spare the makers the pairs they show to be far or every pair is
+ * measured (the first sim, the reference). A pair the kept candidates
+ * missed, or one the skin or the reach test dropped wrongly, would show as
+ * a different frame. */
 static void test_broad_phase_changes_nothing(void **state)
 {
     (void)state;
@@ -388,6 +389,7 @@ static void test_broad_phase_changes_nothing(void **state)
         sim[k]->selfcol->cache.slack = slack[k];
     }
     sim[0]->selfcol->cache.skin_off = true;
+    sim[0]->selfcol->cache.reach_off = true;
     long searches[3] = {0}, traversals[3] = {0}, collisions = 0, repulsions = 0;
     for (int f = 1; f <= scene->frames; f++) {
         for (int k = 0; k < 3; k++) {
@@ -411,10 +413,11 @@ static void test_broad_phase_changes_nothing(void **state)
     assert_true(traversals[1] < searches[1]);
     assert_true(traversals[2] <= traversals[1]);
     assert_true(sim[0]->selfcol->cache.skin_skips == 0 && sim[1]->selfcol->cache.skin_skips > 0);
+    assert_true(sim[0]->selfcol->cache.reach_skips == 0 && sim[1]->selfcol->cache.reach_skips > 0);
     print_message("broad phase: %ld searches; traversals %ld, %ld, %ld; %ld collisions; the "
-                  "skin spared %ld pairs\n",
+                  "reach test skipped %ld candidates, the skin spared %ld pairs\n",
                   searches[0], traversals[0], traversals[1], traversals[2], collisions,
-                  sim[1]->selfcol->cache.skin_skips);
+                  sim[1]->selfcol->cache.reach_skips, sim[1]->selfcol->cache.skin_skips);
     for (int k = 0; k < 3; k++)
         cs_sim_destroy(sim[k]);
     cs_scene_destroy(scene);
