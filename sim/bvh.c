@@ -93,37 +93,64 @@ void cs_bvh_free(cs_bvh *t)
     free(t->count);
     free(t->order);
     free(t->leaf_box);
+    free(t->vbox);
+    free(t->leaf_vbox);
     free(t->rank_lo);
     free(t->rank_hi);
     memset(t, 0, sizeof *t);
 }
 
-void cs_bvh_refit(cs_bvh *t, const cs_box *pb)
+/* node_box from the primitives' boxes pb, bottom-up; leaf_box gets them in
+ * leaf order */
+static void refit_boxes(cs_bvh *t, const cs_box *pb, cs_box *node_box, cs_box *leaf_box)
 {
     for (int node = t->nnodes - 1; node >= 0; node--) {
-        cs_box *b = t->box + node;
+        cs_box *b = node_box + node;
         int l = t->child[2 * node];
         if (l < 0) {
             cs_box_empty(b);
             for (int k = t->first[node]; k < t->first[node] + t->count[node]; k++) {
                 int p = t->order[k];
-                t->leaf_box[k] = pb[p];
+                leaf_box[k] = pb[p];
                 cs_box_add_point(b, pb[p].lo);
                 cs_box_add_point(b, pb[p].hi);
             }
         } else {
             int r = t->child[2 * node + 1];
-            *b = t->box[l];
-            cs_box_add_point(b, t->box[r].lo);
-            cs_box_add_point(b, t->box[r].hi);
+            *b = node_box[l];
+            cs_box_add_point(b, node_box[r].lo);
+            cs_box_add_point(b, node_box[r].hi);
         }
     }
+}
+
+void cs_bvh_refit(cs_bvh *t, const cs_box *pb)
+{
+    refit_boxes(t, pb, t->box, t->leaf_box);
+}
+
+int cs_bvh_refit_motion(cs_bvh *t, const cs_box *prim_box, const cs_box *prim_vbox)
+{
+    if (!t->vbox) {
+        t->vbox = malloc(sizeof *t->vbox * ((size_t)t->nnodes + 1));
+        t->leaf_vbox = malloc(sizeof *t->leaf_vbox * ((size_t)t->nprims + 1));
+        if (!t->vbox || !t->leaf_vbox) {
+            free(t->vbox);
+            free(t->leaf_vbox);
+            t->vbox = t->leaf_vbox = NULL;
+            return -1;
+        }
+    }
+    refit_boxes(t, prim_box, t->box, t->leaf_box);
+    refit_boxes(t, prim_vbox, t->vbox, t->leaf_vbox);
+    return 0;
 }
 
 typedef struct traversal {
     const cs_bvh *A, *B;
     bool self;
     int rank;
+    const cs_reach *reach; /* NULL: box overlap */
     int depth;            /* planning: node pairs this deep become tasks */
     cs_bvh_work *plan;    /* planning: where the tasks go; NULL when traversing */
     cs_index_pairs *out;  /* traversing: where the pairs go */
@@ -180,16 +207,19 @@ static void leaf_pairs(traversal *tr, int i, int j)
     /* the bounds in locals: push_pair's stores may alias the tree's arrays */
     const int ka_end = A->first[i] + A->count[i], kb_end = B->first[j] + B->count[j];
     const cs_box *node_b = B->box + j;
+    const cs_reach *reach = tr->reach;
     for (int ka = A->first[i]; ka < ka_end; ka++) {
         int a = A->order[ka];
-        const cs_box *ba = A->leaf_box + ka;
+        const cs_box *ba = A->leaf_box + ka, *va = reach ? A->leaf_vbox + ka : NULL;
         /* most leaf pairs' primitives miss each other: one test against
          * the other leaf's box spares the primitives' tests */
-        if (!cs_box_overlap_branchless(ba, node_b))
+        if (reach ? !cs_in_reach(ba, va, node_b, B->vbox + j, reach)
+                  : !cs_box_overlap_branchless(ba, node_b))
             continue;
         int kb0 = (tr->self && i == j) ? ka + 1 : B->first[j];
         for (int kb = kb0; kb < kb_end; kb++) {
-            if (!cs_box_overlap_branchless(ba, B->leaf_box + kb))
+            if (reach ? !cs_in_reach(ba, va, B->leaf_box + kb, B->leaf_vbox + kb, reach)
+                      : !cs_box_overlap_branchless(ba, B->leaf_box + kb))
                 continue;
             int b = B->order[kb];
             if (share_vertex(A, a, B, b))
@@ -246,7 +276,8 @@ static void descend(traversal *tr, int i, int j, int depth)
         descend(tr, l, r, depth + 1);
         return;
     }
-    if (!cs_box_overlap(A->box + i, B->box + j))
+    if (tr->reach ? !cs_in_reach(A->box + i, A->vbox + i, B->box + j, B->vbox + j, tr->reach)
+                  : !cs_box_overlap(A->box + i, B->box + j))
         return;
     int la = A->child[2 * i], lb = B->child[2 * j];
     if (planned(tr, i, j, depth, la < 0 && lb < 0))
@@ -278,14 +309,16 @@ static void descend(traversal *tr, int i, int j, int depth)
  * so uneven ones even out. */
 enum { TASK_DEPTH = 8 };
 
-int cs_bvh_collect(const cs_bvh *A, const cs_bvh *B, int rank, cs_bvh_work *w,
-                   cs_index_pairs *out)
+int cs_bvh_collect(const cs_bvh *A, const cs_bvh *B, int rank, const cs_reach *reach,
+                   cs_bvh_work *w, cs_index_pairs *out)
 {
     out->n = 0;
     w->ntasks = 0;
     if (A->nnodes == 0 || B->nnodes == 0)
         return 0;
-    traversal plan = {A, B, A == B, rank, TASK_DEPTH, w, NULL, 0};
+    if (reach && (!A->vbox || !B->vbox))
+        return -1;
+    traversal plan = {A, B, A == B, rank, reach, TASK_DEPTH, w, NULL, 0};
     descend(&plan, 0, 0, 0);
     if (plan.failed)
         return -1;
@@ -321,7 +354,7 @@ int cs_bvh_collect(const cs_bvh *A, const cs_bvh *B, int rank, cs_bvh_work *w,
 #pragma omp for schedule(dynamic, 1)
         for (int t = 0; t < w->ntasks; t++) {
             int first = found.n;
-            traversal tr = {A, B, A == B, rank, 0, NULL, &found, 0};
+            traversal tr = {A, B, A == B, rank, reach, 0, NULL, &found, 0};
             descend(&tr, w->task[2 * t], w->task[2 * t + 1], 0);
             w->task_first[3 * t] = first;
             w->task_first[3 * t + 1] = found.n - first;

@@ -21,6 +21,10 @@ typedef struct cs_bvh {
     int *first, *count;   /* leaf: primitives order[first .. first+count) */
     int *order;           /* primitive ids in leaf order */
     cs_box *leaf_box;     /* their boxes in leaf order, from the last refit */
+    /* per node and per primitive in leaf order: the extent of the
+     * primitives' velocities, from the last cs_bvh_refit_motion (NULL
+     * before it) */
+    cs_box *vbox, *leaf_vbox;
     int *rank_lo, *rank_hi; /* per node: the ranks its primitives go to */
     /* each primitive's particles, nvertices apiece (cs_bvh_set_vertices;
      * NULL: primitive k is particle k) */
@@ -32,6 +36,10 @@ int cs_bvh_build(cs_bvh *t, int nprims, const cs_box *prim_box);
 void cs_bvh_free(cs_bvh *t);
 /* Sets node boxes from primitive boxes. */
 void cs_bvh_refit(cs_bvh *t, const cs_box *prim_box);
+
+/* Sets node boxes from the primitives' position and velocity boxes, for a
+ * traversal within reach. Returns 0 or -1 (no memory). */
+int cs_bvh_refit_motion(cs_bvh *t, const cs_box *prim_box, const cs_box *prim_vbox);
 
 /* Section 7: each primitive's rank (the lowest owner of its particles); a
  * pair goes to the lower of its two primitives' ranks. */
@@ -65,10 +73,13 @@ void cs_bvh_work_free(cs_bvh_work *w);
  * the node pairs near the top become tasks that OpenMP threads traverse
  * into one list per thread, joined in task order. The boxes are those of the
  * last cs_bvh_refit of each tree. With rank >= 0 (after cs_bvh_set_ranks
- * on both trees), node pairs that cannot hold a pair going to rank.
+ * on both trees), node pairs that cannot hold a pair going to rank. With
+ * reach, the pairs within reach (cs_in_reach) instead of those whose boxes
+ * overlap, from the last cs_bvh_refit_motion of each tree.
  * Returns 0 or -1 (no memory). */
-int cs_bvh_collect(const cs_bvh *A, const cs_bvh *B, int rank, cs_bvh_work *w,
-                   cs_index_pairs *out);
+typedef struct cs_reach cs_reach;
+int cs_bvh_collect(const cs_bvh *A, const cs_bvh *B, int rank, const cs_reach *reach,
+                   cs_bvh_work *w, cs_index_pairs *out);
 
 static inline bool cs_box_overlap(const cs_box *a, const cs_box *b)
 {
@@ -83,6 +94,38 @@ static inline bool cs_box_overlap_branchless(const cs_box *a, const cs_box *b)
 {
     return (a->lo[0] <= b->hi[0]) & (b->lo[0] <= a->hi[0]) & (a->lo[1] <= b->hi[1]) &
            (b->lo[1] <= a->hi[1]) & (a->lo[2] <= b->hi[2]) & (b->lo[2] <= a->hi[2]);
+}
+
+/* Step A's reach: its makers keep a pair only if it is closer than
+ * thickness + (relative speed) span, the speed the largest between a
+ * vertex of each side. */
+struct cs_reach {
+    double thickness, span;
+};
+
+/* Whether two primitives (or two nodes' worth of them) whose vertices lie
+ * in the position boxes xa and xb and move at velocities in va and vb may
+ * hold such a pair: the boxes' gap, which bounds every distance between
+ * them from below, is short of the thickness plus the largest relative
+ * speed the velocity boxes allow (every speed between them is at most
+ * that) times the span. Neither bound needs a common velocity, so a sheet
+ * moving fast against its mean velocity but slowly against its neighbours
+ * reaches only them. The factors 1 -+ 1e-9 are far above the makers'
+ * round-off, so a pair out of reach is one the makers drop. */
+static inline bool cs_in_reach(const cs_box *xa, const cs_box *va, const cs_box *xb,
+                               const cs_box *vb, const cs_reach *r)
+{
+    double gap = 0, rel = 0;
+    for (int d = 0; d < 3; d++) {
+        double g = xb->lo[d] - xa->hi[d], h = xa->lo[d] - xb->hi[d];
+        g = g > h ? g : h;
+        g = g > 0 ? g : 0;
+        gap += g * g;
+        double u = va->hi[d] - vb->lo[d], w = vb->hi[d] - va->lo[d];
+        u = u > w ? u : w;
+        rel += u * u;
+    }
+    return !(sqrt(gap) * (1 - 1e-9) >= r->thickness + sqrt(rel) * (1 + 1e-9) * r->span);
 }
 
 static inline void cs_box_empty(cs_box *b)

@@ -65,8 +65,14 @@ cs_selfcol *cs_selfcol_create(const cs_sim *sim)
     sc->pbox = calloc((size_t)n + 1, sizeof *sc->pbox);
     sc->ebox = calloc((size_t)ne + 1, sizeof *sc->ebox);
     sc->tbox = calloc((size_t)nt + 1, sizeof *sc->tbox);
-    sc->emotion = malloc(sizeof *sc->emotion * ((size_t)ne + 1));
-    sc->tmotion = malloc(sizeof *sc->tmotion * ((size_t)nt + 1));
+    cs_motion_boxes *motion[3] = {&sc->pmotion, &sc->emotion, &sc->tmotion};
+    int motion_count[3] = {n, ne, nt};
+    for (int k = 0; k < 3; k++) {
+        motion[k]->x = malloc(sizeof(cs_box) * ((size_t)motion_count[k] + 1));
+        motion[k]->v = malloc(sizeof(cs_box) * ((size_t)motion_count[k] + 1));
+        if (!motion[k]->x || !motion[k]->v)
+            goto fail;
+    }
     sc->pdirty = calloc((size_t)n + 1, 1);
     sc->vdirty = calloc((size_t)n + 1, 1);
     sc->collided = calloc((size_t)n + 1, 1);
@@ -84,7 +90,7 @@ cs_selfcol *cs_selfcol_create(const cs_sim *sim)
     sc->x_pass = malloc(sizeof(double) * 3 * (size_t)(n + 1));
     if (!sc->prim_rank || !sc->component || !sc->x_pass)
         goto fail;
-    if (!sc->pbox || !sc->ebox || !sc->tbox || !sc->emotion || !sc->tmotion || !sc->pdirty || !sc->vdirty || !sc->collided ||
+    if (!sc->pbox || !sc->ebox || !sc->tbox || !sc->pdirty || !sc->vdirty || !sc->collided ||
         !sc->edirty || !sc->tdirty || !sc->x_free || !sc->x_before || !sc->inv_mass || !sc->zone ||
         !sc->zone_list)
         goto fail;
@@ -136,7 +142,8 @@ void cs_selfcol_destroy(cs_selfcol *sc)
     cs_bvh_free(&sc->etree);
     cs_bvh_free(&sc->ttree);
     void *arrays[] = {sc->edge, sc->tri, sc->ring_start, sc->ring, sc->pbox, sc->ebox, sc->tbox,
-                      sc->emotion, sc->tmotion, sc->pdirty, sc->collided, sc->edirty,
+                      sc->pmotion.x, sc->pmotion.v, sc->emotion.x, sc->emotion.v,
+                      sc->tmotion.x, sc->tmotion.v, sc->reach_pt.ab, sc->reach_ee.ab, sc->pdirty, sc->collided, sc->edirty,
                       sc->tdirty, sc->vdirty, sc->x_free, sc->x_before, sc->inv_mass, sc->zone,
                       sc->zone_list, sc->pt.p, sc->ee.p, sc->cpt.p, sc->cee.p,
                       sc->prim_rank, sc->component, sc->bpt.p, sc->bee.p, sc->x_pass,

@@ -62,12 +62,13 @@ typedef struct cs_made_list {
     char pad[64 - 2 * sizeof(int) - sizeof(cs_made_pair *) - sizeof(double)];
 } cs_made_list;
 
-/* A primitive's extent in position (its vertices in x_free) and in velocity
- * (theirs in v) at step A's search: what bounds, for every pair of two such
- * primitives, the distance from below and the relative speed from above. */
-typedef struct cs_motion_box {
-    double lo[3], hi[3], vlo[3], vhi[3];
-} cs_motion_box;
+/* Per primitive at step A's search, the extent of its vertices' positions
+ * in x_free (x) and of their velocities (v): what bounds the distance of a
+ * pair of primitives from below and its relative speed from above
+ * (cs_in_reach, bvh.h). */
+typedef struct cs_motion_boxes {
+    cs_box *x, *v;
+} cs_motion_boxes;
 
 /* Candidate pairs kept between searches (selfcol_cache.c). */
 typedef struct cs_pair_cache {
@@ -92,7 +93,8 @@ typedef struct cs_pair_cache {
     bool skin_off;               /* tests: step A measures every pair */
     long skin_skips;             /* pairs the skin spared the makers, in all */
     bool reach_off;              /* tests: no reach test (sc_find_pairs) */
-    long reach_skips;            /* candidates the reach test skipped, in all */
+    long reach_skips;            /* cached candidates the reach test skipped */
+    long reach_traversals;       /* step A's searches that traversed within reach */
 } cs_pair_cache;
 
 /* A collision inside an impact zone that spans two prescribed motions, as
@@ -123,7 +125,12 @@ typedef struct cs_selfcol {
     int *ring_start, *ring;    /* each particle's neighbours along edges */
     cs_bvh ptree, etree, ttree;
     cs_box *pbox, *ebox, *tbox;
-    cs_motion_box *emotion, *tmotion; /* per edge and triangle, step A's */
+    cs_motion_boxes pmotion, emotion, tmotion; /* per particle, edge, triangle */
+    /* step A's candidates when its search traversed the trees within
+     * reach instead of using the cache (selfcol_cache.c), and whether the
+     * present search's are those */
+    cs_index_pairs reach_pt, reach_ee;
+    bool reached;
     unsigned char *pdirty, *edirty, *tdirty, *vdirty;
     unsigned char *collided;   /* step C: in a pair the last pass found */
     double *x_free;            /* the last collision-free positions */

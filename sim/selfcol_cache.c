@@ -15,8 +15,9 @@
  * A search's pairs are sorted by (a, b) (sc_find_pairs), so they come in
  * one order whatever the cache's history (when it was built, or a run
  * resumed from a checkpoint with an empty cache): the makers are exact,
- * the boxes only a conservative filter, so the lists do not depend on the
- * broad phase at all. */
+ * and the present boxes, which decide with them, are tested on every
+ * candidate whichever way it came (the cache, or step A's traversal within
+ * reach), so the lists do not depend on the broad phase at all. */
 #include <math.h>
 #include <omp.h>
 #include <stdlib.h>
@@ -247,8 +248,8 @@ static int rebuild(cs_selfcol *sc, int rank, double thickness, const double anch
     cs_bvh_refit(&sc->etree, c->ebox);
     cs_bvh_refit(&sc->ttree, c->tbox);
     c->valid = false;
-    if (cs_bvh_collect(&sc->ptree, &sc->ttree, rank, &sc->bvh_work, &c->pt) ||
-        cs_bvh_collect(&sc->etree, &sc->etree, rank, &sc->bvh_work, &c->ee))
+    if (cs_bvh_collect(&sc->ptree, &sc->ttree, rank, NULL, &sc->bvh_work, &c->pt) ||
+        cs_bvh_collect(&sc->etree, &sc->etree, rank, NULL, &sc->bvh_work, &c->ee))
         return -1;
     if (skin_reset(sc))
         return -1;
@@ -259,15 +260,44 @@ static int rebuild(cs_selfcol *sc, int rank, double thickness, const double anch
     return 0;
 }
 
+/* Step A's candidates within reach (cs_in_reach), from one traversal of
+ * the trees refitted to the motion boxes, into sc->reach_pt and reach_ee */
+static int traverse_within_reach(cs_selfcol *sc, int rank, const cs_reach *reach)
+{
+    if (cs_bvh_refit_motion(&sc->ptree, sc->pmotion.x, sc->pmotion.v) ||
+        cs_bvh_refit_motion(&sc->etree, sc->emotion.x, sc->emotion.v) ||
+        cs_bvh_refit_motion(&sc->ttree, sc->tmotion.x, sc->tmotion.v) ||
+        cs_bvh_collect(&sc->ptree, &sc->ttree, rank, reach, &sc->bvh_work, &sc->reach_pt) ||
+        cs_bvh_collect(&sc->etree, &sc->etree, rank, reach, &sc->bvh_work, &sc->reach_ee))
+        return -1;
+    sc->stats.cache_builds++;
+    sc->cache.reach_traversals++;
+    return 0;
+}
+
 int sc_cache_update(cs_selfcol *sc, int rank, double thickness, const double *v,
-                    const double mean[3])
+                    const double mean[3], const cs_reach *reach)
 {
     double now[3], T[3];
     centroid(sc, now);
     sc->stats.cache_searches++;
     sc->cache.served++;
+    sc->reached = false;
     cs_sub(now, sc->cache.anchor, T);
     bool fits = sc->cache.valid && sc->cache.slack >= 0 && contained(sc, T);
+    /* A cache that lasted no longer than its own build and step C's search
+     * after it would be rebuilt from this search's boxes, which grow by
+     * the particles' speeds against the mean: in a landing, millions of
+     * candidates that reach would drop. Step A then traverses within reach
+     * (about a twentieth of the candidates, and a cheaper traversal) and
+     * leaves the cache, which did not serve it, to step C, whose boxes are
+     * smaller. Once step C's caches last, step A rebuilds the cache again
+     * and shares it. */
+    if (!fits && reach && sc->cache.valid && sc->cache.served <= CACHE_TIGHT_SERVED) {
+        sc->cache.served--;
+        sc->reached = true;
+        return traverse_within_reach(sc, rank, reach);
+    }
     int failed = fits ? 0 : rebuild(sc, rank, thickness, now);
     if (v && !failed)
         skin_measure(sc, v, mean, now);
@@ -331,41 +361,24 @@ static int by_candidate(const void *pa, const void *pb)
     return x->a != y->a ? (x->a > y->a) - (x->a < y->a) : (x->b > y->b) - (x->b < y->b);
 }
 
-/* Whether the pair of primitive a (motion box a, or the point x, v when
- * a is NULL) and b's motion box is out of reach: the boxes' gap, which the
- * sides' distance is at least, reaches past the thickness plus the largest
- * relative speed their velocity extents allow times the span. Then the
- * makers would drop the pair (it is past may_meet's reach, the speed
- * between its vertices being at most that) without lowering start_gap
+/* Step A's reach test on cached candidates: a pair out of reach is one the
+ * makers would drop (past may_meet's reach) without lowering start_gap
  * (capped below the thickness), so skipping it changes no bit. The box
  * overlap that found the candidate widens every box by its particles'
  * speeds relative to the cloth's mean velocity; in a landing most of the
  * sheet moves fast against the mean but slowly against its neighbours,
- * and this test, which needs no common velocity, leaves the makers a small
- * part of the candidates of the 100 x 100 sheet. The factors 1 -+ 1e-9
- * are far above the makers' round-off. */
-static bool out_of_reach(const cs_motion_box *a, const double *x, const double *v,
-                         const cs_motion_box *b, const sc_reach *reach)
-{
-    const double *lo = a ? a->lo : x, *hi = a ? a->hi : x;
-    const double *vlo = a ? a->vlo : v, *vhi = a ? a->vhi : v;
-    double gap = 0, rel = 0;
-    for (int d = 0; d < 3; d++) {
-        double g = b->lo[d] - hi[d], h = lo[d] - b->hi[d];
-        g = g > h ? g : h;
-        g = g > 0 ? g : 0;
-        gap += g * g;
-        double u = vhi[d] - b->vlo[d], w = b->vhi[d] - vlo[d];
-        u = u > w ? u : w;
-        rel += u * u;
-    }
-    return sqrt(gap) * (1 - 1e-9) >= reach->thickness + sqrt(rel) * (1 + 1e-9) * reach->span;
-}
-
-int sc_find_pairs(cs_selfcol *sc, bool edges, bool only_dirty, const sc_reach *reach,
+ * and the reach test leaves the makers about 5% of the 100 x 100 sheet's
+ * candidates (docs/performance.md, "Step A's reach"). */
+int sc_find_pairs(cs_selfcol *sc, bool edges, bool only_dirty, const cs_reach *reach,
                   const sc_skin *skin, pair_maker make, const void *ctx, cs_pair_list *list)
 {
-    const cs_index_pairs *cand = edges ? &sc->cache.ee : &sc->cache.pt;
+    bool reached = reach && sc->reached; /* the candidates are within reach */
+    const cs_index_pairs *cand = reached ? (edges ? &sc->reach_ee : &sc->reach_pt)
+                                         : (edges ? &sc->cache.ee : &sc->cache.pt);
+    const cs_motion_boxes *ma = edges ? &sc->emotion : &sc->pmotion;
+    const cs_motion_boxes *mb = edges ? &sc->emotion : &sc->tmotion;
+    if (reached)
+        skin = NULL; /* its distances are the cache's */
     const cs_box *boxa = edges ? sc->ebox : sc->pbox, *boxb = edges ? sc->ebox : sc->tbox;
     const unsigned char *da = edges ? sc->edirty : sc->pdirty;
     const unsigned char *db = edges ? sc->edirty : sc->tdirty;
@@ -388,11 +401,18 @@ int sc_find_pairs(cs_selfcol *sc, bool edges, bool only_dirty, const sc_reach *r
         for (int k = 0; k < cand->n; k++) {
             int a = cand->ab[2 * k], b = cand->ab[2 * k + 1];
             cs_pair p;
+            /* the boxes decide with the makers, within reach or not: a
+             * box grows around each vertex by that vertex's speed, so a
+             * pair near a triangle's slow side and reaching its fast
+             * vertex can pass may_meet and miss the boxes, and so is no
+             * pair of a search's through the cache. Reach holds every pair
+             * may_meet keeps, and the boxes leave the same pairs on either
+             * way, whatever the cache's history (a resumed run's first
+             * search). */
             if ((only_dirty && !da[a] && !db[b]) || !cs_box_overlap_branchless(boxa + a, boxb + b))
                 continue;
-            if (reach && out_of_reach(edges ? sc->emotion + a : NULL, sc->x_free + 3 * a,
-                                      reach->v + 3 * a,
-                                      edges ? sc->emotion + b : sc->tmotion + b, reach)) {
+            if (reach && !reached &&
+                !cs_in_reach(ma->x + a, ma->v + a, mb->x + b, mb->v + b, reach)) {
                 unreached++;
                 continue;
             }

@@ -251,7 +251,7 @@ static long find_collisions(cs_selfcol *sc, const cs_par *par, const double *x,
     }
     sc->cpt.n = sc->cee.n = 0;
     collector cl = {sc, par, x};
-    if (sc_cache_update(sc, par->rank, thickness, NULL, NULL) ||
+    if (sc_cache_update(sc, par->rank, thickness, NULL, NULL, NULL) ||
         sc_find_pairs(sc, false, only_dirty, NULL, NULL, make_collision_point_triangle, &cl,
                       &sc->cpt) ||
         sc_find_pairs(sc, true, only_dirty, NULL, NULL, make_collision_edge_edge, &cl, &sc->cee))

@@ -45,9 +45,13 @@ bool sc_sides_apart(const double *const p[4], int split, double gap);
  * (around x_free): makes the cache hold every pair whose boxes can overlap,
  * traversing the trees only when a particle's box left its grown box;
  * with v (step A: the velocities, mean their mean), measures the skin's
- * motion for this search. Returns 0 or -1 (no memory). */
+ * motion for this search. With reach (step A, its motion boxes in
+ * sc->pmotion, emotion, tmotion), where the cache would be rebuilt from
+ * this search's own boxes (it lasted no longer than that), traverses
+ * within reach instead into sc->reach_pt and reach_ee and sets
+ * sc->reached, leaving the cache to step C. Returns 0 or -1 (no memory). */
 int sc_cache_update(cs_selfcol *sc, int rank, double thickness, const double *v,
-                    const double mean[3]);
+                    const double mean[3], const cs_reach *reach);
 int sc_cache_create(cs_selfcol *sc);
 void sc_cache_free(cs_selfcol *sc);
 /* What step A's makers keep and measure: a pair closer than
@@ -57,21 +61,13 @@ void sc_cache_free(cs_selfcol *sc);
 typedef struct sc_skin {
     double thickness, span, gap_cap;
 } sc_skin;
-/* Step A's reach: its makers keep a pair only if it is closer than
- * thickness + (relative speed) span, with the speed the largest between
- * a vertex of each side, at x_free and the velocities v; the edges' and
- * triangles' motion boxes (sc->emotion, tmotion) hold their extents in
- * both. */
-typedef struct sc_reach {
-    double thickness, span;
-    const double *v;
-} sc_reach;
 /* The cached point/triangle (edges: edge/edge) pairs whose present boxes
- * overlap (only_dirty: with a dirty side), that reach (NULL: none) does
- * not show to be out of reach, that skin (NULL: none) does not show to be
- * far, and that make accepts, appended to list in (a, b) order at any
- * thread count. Returns 0 or -1. */
-int sc_find_pairs(cs_selfcol *sc, bool edges, bool only_dirty, const sc_reach *reach,
+ * overlap (only_dirty: with a dirty side), that are within reach (NULL:
+ * no test; step A's motion boxes, cs_in_reach), that skin (NULL: none)
+ * does not show to be far, and that make accepts, appended to list in
+ * (a, b) order at any thread count; after a search that sc->reached,
+ * reach's candidates instead, those make accepts. Returns 0 or -1. */
+int sc_find_pairs(cs_selfcol *sc, bool edges, bool only_dirty, const cs_reach *reach,
                   const sc_skin *skin, pair_maker make, const void *ctx, cs_pair_list *list);
 
 /* ---- selfcol_project.c: zones across prescribed motions */

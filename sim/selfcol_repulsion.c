@@ -142,20 +142,17 @@ static bool make_repulsion_edge_edge(const void *ctx, int ea, int eb, cs_pair *o
     return true;
 }
 
-/* m = the extents of the vertices' positions in x and velocities in v */
-static void motion_box(cs_motion_box *m, const int *vert, int count, const double *x,
-                       const double *v)
+/* primitive k's motion boxes: the extents of its count vertices' positions
+ * in x and velocities in v */
+static void motion_boxes(cs_motion_boxes *m, int k, const int *vert, int count,
+                         const double *x, const double *v)
 {
-    for (int d = 0; d < 3; d++) {
-        m->lo[d] = m->hi[d] = x[3 * vert[0] + d];
-        m->vlo[d] = m->vhi[d] = v[3 * vert[0] + d];
-        for (int j = 1; j < count; j++) {
-            double p = x[3 * vert[j] + d], u = v[3 * vert[j] + d];
-            m->lo[d] = p < m->lo[d] ? p : m->lo[d];
-            m->hi[d] = p > m->hi[d] ? p : m->hi[d];
-            m->vlo[d] = u < m->vlo[d] ? u : m->vlo[d];
-            m->vhi[d] = u > m->vhi[d] ? u : m->vhi[d];
-        }
+    cs_box *bx = m->x + k, *bv = m->v + k;
+    cs_box_empty(bx);
+    cs_box_empty(bv);
+    for (int j = 0; j < count; j++) {
+        cs_box_add_point(bx, x + 3 * vert[j]);
+        cs_box_add_point(bv, v + 3 * vert[j]);
     }
 }
 
@@ -171,7 +168,8 @@ void cs_selfcol_find_pairs(cs_sim *sim, double span)
      * particle would cover in the span at its present velocity relative to
      * the cloth's mean velocity, along all three axes (a pair's relative
      * speed is at most the sum of its particles' speeds relative to any
-     * common velocity, so every pair may_meet keeps is found). `path`: the
+     * common velocity; a pair is kept where its boxes overlap and may_meet
+     * holds, whichever way sc_find_pairs took its candidates). `path`: the
      * particle's straight path relative to the mean, x + (v - mean) s for s
      * in [0, span], grown by half the thickness; if a pair's straight
      * relative path comes within the thickness at some s, the points x_a +
@@ -228,15 +226,20 @@ void cs_selfcol_find_pairs(cs_sim *sim, double span)
             cs_box_add_point(b, sc->pbox[i].hi);
         }
     }
-    /* the motion boxes, for sc_find_pairs' reach */
+    /* the motion boxes, for the reach test */
 #pragma omp parallel for schedule(static)
-    for (int k = 0; k < sc->ne + sc->nt; k++) {
-        bool edge = k < sc->ne;
-        const int *vert = edge ? sc->edge + 2 * k : sc->tri + 3 * (k - sc->ne);
-        cs_motion_box *m = edge ? sc->emotion + k : sc->tmotion + (k - sc->ne);
-        motion_box(m, vert, edge ? 2 : 3, x, sim->v);
+    for (int k = 0; k < sc->n + sc->ne + sc->nt; k++) {
+        if (k < sc->n) {
+            motion_boxes(&sc->pmotion, k, &k, 1, x, sim->v);
+        } else if (k < sc->n + sc->ne) {
+            int e = k - sc->n;
+            motion_boxes(&sc->emotion, e, sc->edge + 2 * e, 2, x, sim->v);
+        } else {
+            int t = k - sc->n - sc->ne;
+            motion_boxes(&sc->tmotion, t, sc->tri + 3 * t, 3, x, sim->v);
+        }
     }
-    sc_reach reach = {thickness, span, sim->v}, *reaching = sc->cache.reach_off ? NULL : &reach;
+    cs_reach reach = {thickness, span}, *reaching = sc->cache.reach_off ? NULL : &reach;
     finder f = {sim, sc, thickness, span};
     for (int t = 0; t < sc->nmade; t++) /* threads added by the searches start at 0 */
         sc->made[t].nearest = INFINITY;
@@ -247,7 +250,7 @@ void cs_selfcol_find_pairs(cs_sim *sim, double span)
      * the boxes' round-off) */
     double gap = 0.999 * thickness;
     sc_skin skin = {thickness, span, gap}, *use = sc->cache.skin_off ? NULL : &skin;
-    int failed = sc_cache_update(sc, sim->par->rank, thickness, sim->v, mean) ||
+    int failed = sc_cache_update(sc, sim->par->rank, thickness, sim->v, mean, reaching) ||
                  sc_find_pairs(sc, false, false, reaching, use, make_repulsion_point_triangle, &f,
                                &sc->pt) ||
                  sc_find_pairs(sc, true, false, reaching, use, make_repulsion_edge_edge, &f, &sc->ee);
