@@ -13,8 +13,8 @@ Three measurements, each a plain `clothsim run` at the scene's defaults
                 bench/twist_state.sh build out/twist_500k
               (frame 42, made at coarser resolutions and carried onto the
               fine cloth with run --start-from, which then simulates frame
-              42 itself: about 10 minutes on 2 cores; not committed, about
-              1 GB) and given with --twist-state out/twist_500k. Without it
+              42 itself: about half an hour on 2 cores; not committed,
+              about 1 GB) and given with --twist-state out/twist_500k. Without it
               the twist is skipped.
   twist0      the same twist's first frame from rest (--only twist0, not run
               by default: about 11 minutes a run on 2 cores)

@@ -1,8 +1,9 @@
 #!/bin/sh
 # bench/twist_state.sh [BUILD_DIR] [OUT]: the tangled state of the
 # half-million-triangle twist that bench/paper_scale.py --twist-state
-# resumes, made in about 10 minutes on 2 cores instead of the hours 42
-# frames at 1000 x 250 quads would take.
+# resumes, made in about half an hour on 2 cores (its three runs took
+# 44 s, 5.6 min and 27 min on the 2-vCPU VM of docs/performance.md)
+# instead of the hours 42 frames at 1000 x 250 quads would take.
 #
 # scenes/figures/twist.yaml runs 40 frames (1.67 s: 3.3 relative turns,
 # the ends 0.33 m closer, the sheet a rope lying on itself) at 100 x 25
