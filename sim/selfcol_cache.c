@@ -192,10 +192,17 @@ static bool skin_far(cs_selfcol *sc, bool edges, int k, int a, int b, const sc_s
     return *ref - (moved[0] + moved[1]) >= keep + SKIN_MARGIN_PER_THICKNESS * skin->thickness;
 }
 
+/* Whether the cache served no more searches than CACHE_TIGHT_SERVED, this
+ * one included: the one that built it and step C's after it */
+static bool lasted_one_search(const cs_pair_cache *c)
+{
+    return c->valid && c->served <= CACHE_TIGHT_SERVED;
+}
+
 static int rebuild(cs_selfcol *sc, int rank, double thickness, const double anchor[3])
 {
     cs_pair_cache *c = &sc->cache;
-    bool tight = c->valid && c->served <= CACHE_TIGHT_SERVED;
+    bool tight = lasted_one_search(c);
     double slack = tight ? 0 : fmax(c->slack, 0) * thickness;
     bool forecast = c->valid && c->served >= CACHE_FORECAST_AFTER; /* never tight */
     /* room for step A's boxes (half the thickness around x_free, more for
@@ -293,7 +300,7 @@ int sc_cache_update(cs_selfcol *sc, int rank, double thickness, const double *v,
      * leaves the cache, which did not serve it, to step C, whose boxes are
      * smaller. Once step C's caches last, step A rebuilds the cache again
      * and shares it. */
-    if (!fits && reach && sc->cache.valid && sc->cache.served <= CACHE_TIGHT_SERVED) {
+    if (!fits && reach && lasted_one_search(&sc->cache)) {
         sc->cache.served--;
         sc->reached = true;
         return traverse_within_reach(sc, rank, reach);

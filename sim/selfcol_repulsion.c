@@ -204,9 +204,11 @@ void cs_selfcol_find_pairs(cs_sim *sim, double span)
         } else {
             cs_box_thicken(sc->pbox + i, 0.5 * thickness + cs_norm(rel) * span);
         }
+        motion_boxes(&sc->pmotion, i, &i, 1, x, sim->v); /* for the reach test */
     }
 #pragma omp parallel for schedule(static)
     for (int k = 0; k < sc->ne; k++) {
+        motion_boxes(&sc->emotion, k, sc->edge + 2 * k, 2, x, sim->v);
         cs_box *b = sc->ebox + k;
         cs_box_empty(b);
         for (int j = 0; j < 2; j++) {
@@ -218,25 +220,13 @@ void cs_selfcol_find_pairs(cs_sim *sim, double span)
     }
 #pragma omp parallel for schedule(static)
     for (int k = 0; k < sc->nt; k++) {
+        motion_boxes(&sc->tmotion, k, sc->tri + 3 * k, 3, x, sim->v);
         cs_box *b = sc->tbox + k;
         cs_box_empty(b);
         for (int j = 0; j < 3; j++) {
             int i = sc->tri[3 * k + j];
             cs_box_add_point(b, sc->pbox[i].lo);
             cs_box_add_point(b, sc->pbox[i].hi);
-        }
-    }
-    /* the motion boxes, for the reach test */
-#pragma omp parallel for schedule(static)
-    for (int k = 0; k < sc->n + sc->ne + sc->nt; k++) {
-        if (k < sc->n) {
-            motion_boxes(&sc->pmotion, k, &k, 1, x, sim->v);
-        } else if (k < sc->n + sc->ne) {
-            int e = k - sc->n;
-            motion_boxes(&sc->emotion, e, sc->edge + 2 * e, 2, x, sim->v);
-        } else {
-            int t = k - sc->n - sc->ne;
-            motion_boxes(&sc->tmotion, t, sc->tri + 3 * t, 3, x, sim->v);
         }
     }
     cs_reach reach = {thickness, span}, *reaching = sc->cache.reach_off ? NULL : &reach;
